@@ -1,0 +1,61 @@
+"""Contact forces on the robot's pads, read from the plant's ContactResults."""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.common.value import Value
+from pydrake.geometry import GeometryId
+from pydrake.multibody.plant import ContactResults
+from pydrake.systems.framework import Context, LeafSystem
+
+
+def pad_forces(
+    results: ContactResults, pad_ids: dict[GeometryId, int], n_pads: int
+) -> np.ndarray:
+    """Net world-frame force on each pad (rows in pad order), N.
+
+    Hydroelastic: F_Ac_W acts on the body of geometry M. Point contact
+    (fallback): contact_force acts on body B. Signs follow from which side of
+    the pair the pad is on.
+    """
+    forces = np.zeros((n_pads, 3))
+    for i in range(results.num_hydroelastic_contacts()):
+        info = results.hydroelastic_contact_info(i)
+        surface = info.contact_surface()
+        f = info.F_Ac_W().translational()
+        if (row := pad_ids.get(surface.id_M())) is not None:
+            forces[row] += f
+        if (row := pad_ids.get(surface.id_N())) is not None:
+            forces[row] -= f
+    for i in range(results.num_point_pair_contacts()):
+        info = results.point_pair_contact_info(i)
+        pair = info.point_pair()
+        f = info.contact_force()
+        if (row := pad_ids.get(pair.id_B)) is not None:
+            forces[row] += f
+        if (row := pad_ids.get(pair.id_A)) is not None:
+            forces[row] -= f
+    return forces
+
+
+class ContactForceReporter(LeafSystem):
+    """Contact results in, one 3-D world force per robot pad out (N).
+
+    Output 'pad_forces_W' is [f_pad0; f_pad1; ...] in the order of pad_names.
+    """
+
+    def __init__(self, pad_names: list[str], pad_ids: list[GeometryId]):
+        super().__init__()
+        self.pad_names = list(pad_names)
+        self._rows = {gid: i for i, gid in enumerate(pad_ids)}
+        self._results = self.DeclareAbstractInputPort(
+            "contact_results", Value(ContactResults())
+        )
+        self.DeclareVectorOutputPort(
+            "pad_forces_W", 3 * len(self.pad_names), self._CalcForces
+        )
+
+    def _CalcForces(self, context: Context, output) -> None:
+        results = self._results.Eval(context)
+        forces = pad_forces(results, self._rows, len(self.pad_names))
+        output.SetFromVector(forces.reshape(-1))

@@ -1,0 +1,127 @@
+"""build_diagram(scenario) -> the Drake diagram of a run and handles to its parts."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.geometry import Meshcat, MeshcatVisualizer, MeshcatVisualizerParams, Role
+from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
+from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
+
+from drake_standup.config import Scenario
+from drake_standup.contacts import ContactForceReporter
+from drake_standup.scene import Scene, add_scene, set_seated_state
+
+
+@dataclass
+class StandupDiagram:
+    """The built diagram and the parts that simulate.py and outputs.py read."""
+
+    diagram: Diagram
+    scene: Scene
+    pad_groups: dict[str, str]  # pad geometry name -> group, in reporter order
+    state_log: VectorLogSink
+    pad_force_log: VectorLogSink
+    visualizer: MeshcatVisualizer | None
+
+
+def _seat_hold_gains(scenario: Scenario, joint_names: list[str]) -> dict:
+    hold = scenario.seat_hold
+    return {name: (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad) for name in joint_names}
+
+
+def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> StandupDiagram:
+    """Plant, seat hold, contact-force reporter, loggers and (optionally) Meshcat."""
+    builder = DiagramBuilder()
+    # The robot's joint names are known only once it is parsed; every iCub
+    # model of icub-models names its 32 revolute joints alike, so the gains map
+    # is built from the scenario's pose keys plus a parse-free default.
+    scene = add_scene(builder, scenario, pd_gains=_AllJoints(scenario))
+    plant = scene.plant
+    instance = scene.robot.model_instance
+
+    # Seat hold: Drake's implicit joint PD toward the seated pose plus constant
+    # gravity feed-forward evaluated at that pose (the chair carries the base).
+    plant_context = plant.CreateDefaultContext()
+    set_seated_state(scene, plant_context, scenario)
+    q0 = plant.GetPositions(plant_context, instance)
+    B = plant.MakeActuationMatrix()
+    tau_g = plant.CalcGravityGeneralizedForces(plant_context)
+    u_ff = B.T @ (-tau_g)
+    Bq = _actuated_position_selector(plant, instance)
+    desired_state = np.concatenate([Bq @ q0, np.zeros(Bq.shape[0])])
+    setpoint = builder.AddNamedSystem("seat_hold_setpoint", ConstantVectorSource(desired_state))
+    feedforward = builder.AddNamedSystem("seat_hold_feedforward", ConstantVectorSource(u_ff))
+    builder.Connect(setpoint.get_output_port(), plant.get_desired_state_input_port(instance))
+    builder.Connect(feedforward.get_output_port(), plant.get_actuation_input_port(instance))
+
+    # Group names as metrics.json reports them (plural where there are two).
+    group_labels = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
+    pad_groups = {
+        name: group_labels.get(group, group)
+        for group, names in scene.robot.contact_groups.items()
+        for name in names
+    }
+    pad_names = list(pad_groups)
+    reporter = builder.AddNamedSystem(
+        "contact_forces",
+        ContactForceReporter(pad_names, [scene.robot.contact_geometries[n] for n in pad_names]),
+    )
+    builder.Connect(plant.get_contact_results_output_port(), reporter.get_input_port())
+
+    state_log = LogVectorOutput(plant.get_state_output_port(instance), builder, scenario.log_period_s)
+    state_log.set_name("state_logger")
+    pad_force_log = LogVectorOutput(reporter.get_output_port(), builder, scenario.log_period_s)
+    pad_force_log.set_name("pad_force_logger")
+
+    visualizer = None
+    if meshcat is not None:
+        vis = scenario.visualization
+        visualizer = MeshcatVisualizer.AddToBuilder(
+            builder,
+            scene.scene_graph,
+            meshcat,
+            MeshcatVisualizerParams(publish_period=vis.publish_period_s, role=Role.kIllustration),
+        )
+        if vis.show_contact_forces:
+            ContactVisualizer.AddToBuilder(
+                builder,
+                plant,
+                meshcat,
+                ContactVisualizerParams(
+                    publish_period=vis.contact_publish_period_s, newtons_per_meter=400.0
+                ),
+            )
+
+    diagram = builder.Build()
+    diagram.set_name("standup")
+    return StandupDiagram(diagram, scene, pad_groups, state_log, pad_force_log, visualizer)
+
+
+class _AllJoints(dict):
+    """Gains map that answers every joint name with the seat-hold gains."""
+
+    def __init__(self, scenario: Scenario):
+        super().__init__()
+        self._gains = (scenario.seat_hold.kp_Nm_per_rad, scenario.seat_hold.kd_Nms_per_rad)
+
+    def __getitem__(self, name: str) -> tuple[float, float]:
+        return self._gains
+
+
+def _actuated_position_selector(plant, instance) -> np.ndarray:
+    """Rows pick each actuated joint's position out of the instance's q."""
+    n_q = plant.num_positions(instance)
+    n_u = plant.num_actuated_dofs(instance)
+    first_q = min(
+        plant.get_joint(j).position_start()
+        for j in plant.GetJointIndices(instance)
+        if plant.get_joint(j).num_positions() > 0
+    )
+    S = np.zeros((n_u, n_q))
+    for index in plant.GetJointActuatorIndices(instance):
+        actuator = plant.get_joint_actuator(index)
+        S[actuator.input_start(), actuator.joint().position_start() - first_q] = 1.0
+    return S

@@ -1,0 +1,102 @@
+"""STL -> OBJ conversion for Drake, with decimation for display.
+
+Drake reads no STL (RobotLocomotion/drake#19408), so every mesh the iCub URDF
+names is converted once into a cache directory outside the repository and
+reused afterwards. The meshes are only used for illustration (the robot's
+collision geometry is a set of primitives, see robot.py), so they are
+decimated with quadric edge collapse to keep the Meshcat recording small.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+import numpy as np
+
+# Bump when the conversion changes so stale cache entries are not reused.
+_CONVERTER_VERSION = "1"
+
+
+def cache_dir() -> Path:
+    """Root of the generated-asset cache ($DRAKE_STANDUP_CACHE or ~/.cache)."""
+    root = os.environ.get("DRAKE_STANDUP_CACHE")
+    if root:
+        return Path(root)
+    xdg = os.environ.get("XDG_CACHE_HOME", str(Path.home() / ".cache"))
+    return Path(xdg) / "drake_standup"
+
+
+def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Reads a binary or ASCII STL; returns (vertices (N, 3), faces (M, 3)).
+
+    Coincident corners are merged so the mesh is indexed, which both shrinks
+    the OBJ and lets the decimator see the connectivity.
+    """
+    data = Path(path).read_bytes()
+    n_tri = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
+    if n_tri >= 0 and len(data) == 84 + 50 * n_tri:
+        record = np.dtype(
+            [("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attr", "<u2")]
+        )
+        corners = np.frombuffer(data, dtype=record, count=n_tri, offset=84)["corners"]
+    else:
+        words = data.decode("ascii", errors="replace").split()
+        coords = [
+            [float(words[i + 1]), float(words[i + 2]), float(words[i + 3])]
+            for i, w in enumerate(words)
+            if w == "vertex"
+        ]
+        corners = np.asarray(coords, dtype=np.float64).reshape(-1, 3, 3)
+    corners = np.asarray(corners, dtype=np.float64).reshape(-1, 3)
+    vertices, inverse = np.unique(corners, axis=0, return_inverse=True)
+    faces = inverse.reshape(-1, 3)
+    keep = (
+        (faces[:, 0] != faces[:, 1])
+        & (faces[:, 1] != faces[:, 2])
+        & (faces[:, 0] != faces[:, 2])
+    )
+    return vertices, faces[keep]
+
+
+def decimate(
+    vertices: np.ndarray, faces: np.ndarray, max_faces: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Quadric decimation down to about max_faces triangles (no-op if smaller)."""
+    if len(faces) <= max_faces:
+        return vertices, faces
+    import fast_simplification
+
+    reduction = 1.0 - max_faces / len(faces)
+    v, f = fast_simplification.simplify(
+        vertices.astype(np.float64), faces.astype(np.int64), target_reduction=reduction
+    )
+    return np.asarray(v), np.asarray(f)
+
+
+def write_obj(path: Path, vertices: np.ndarray, faces: np.ndarray, scale) -> None:
+    """Writes an OBJ with the URDF's scale baked in (0.1 mm resolution)."""
+    v = np.asarray(vertices) * np.asarray(scale, dtype=np.float64)
+    lines = ["# converted by drake_standup from a third-party STL; do not commit\n"]
+    lines += [f"v {x:.4f} {y:.4f} {z:.4f}\n" for x, y, z in v]
+    lines += [f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces]
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text("".join(lines))
+    tmp.replace(path)
+
+
+def converted_obj(stl_path: Path, scale, max_faces: int) -> Path:
+    """Returns the cached OBJ for stl_path, converting on first use."""
+    stl_path = Path(stl_path)
+    key = hashlib.sha1(
+        f"{_CONVERTER_VERSION}|{stl_path.resolve()}|{stl_path.stat().st_size}|"
+        f"{list(scale)}|{max_faces}".encode()
+    ).hexdigest()[:12]
+    out = cache_dir() / "meshes" / f"{stl_path.stem}-{key}.obj"
+    if not out.exists():
+        out.parent.mkdir(parents=True, exist_ok=True)
+        vertices, faces = read_stl(stl_path)
+        vertices, faces = decimate(vertices, faces, max_faces)
+        write_obj(out, vertices, faces, scale)
+    return out

@@ -1,0 +1,92 @@
+"""The world of the stand-up: a discrete MultibodyPlant with the iCub, a chair
+and a floor, hydroelastic contact, and the robot's seated initial state."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, SceneGraph
+from pydrake.math import RigidTransform, RollPitchYaw
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.systems.framework import Context, DiagramBuilder
+
+from drake_standup.config import REPO_ROOT, Scenario
+from drake_standup.robot import Robot, add_icub, set_joint_positions
+
+MODELS_DIR = REPO_ROOT / "models"
+
+
+@dataclass
+class Scene:
+    plant: MultibodyPlant
+    scene_graph: SceneGraph
+    robot: Robot
+
+
+def add_scene(
+    builder: DiagramBuilder,
+    scenario: Scenario,
+    *,
+    pd_gains: dict[str, tuple[float, float]] | None = None,
+    visuals: bool = True,
+) -> Scene:
+    """Adds plant and scene graph to builder; returns the finalized scene."""
+    plant, scene_graph = AddMultibodyPlant(scenario.plant, builder)
+    robot = add_icub(
+        plant,
+        scenario.robot.model,
+        reduce=scenario.robot.reduced,
+        visuals=visuals,
+        effort_limit_Nm=scenario.robot.effort_limit_Nm,
+        pd_gains=pd_gains,
+        visual_max_faces=scenario.robot.visual_max_faces,
+    )
+    parser = Parser(plant)
+    (floor,) = parser.AddModels(str(MODELS_DIR / "floor.sdf"))
+    (chair,) = parser.AddModels(str(_resolve(scenario.chair.file)))
+    world = plant.world_frame()
+    plant.WeldFrames(world, plant.GetFrameByName("floor", floor))
+    plant.WeldFrames(
+        world,
+        plant.GetFrameByName("chair", chair),
+        RigidTransform(scenario.chair.xyz_m),
+    )
+    plant.Finalize()
+
+    # The robot touches the world only through its pads; pads never touch each
+    # other (self-collision is not part of this task).
+    robot_geometries = GeometrySet(list(robot.contact_geometries.values()))
+    scene_graph.collision_filter_manager().Apply(
+        CollisionFilterDeclaration().ExcludeWithin(robot_geometries)
+    )
+    return Scene(plant, scene_graph, robot)
+
+
+def _resolve(path: str) -> Path:
+    p = Path(path)
+    return p if p.is_absolute() else REPO_ROOT / p
+
+
+def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -> None:
+    """Puts the robot in the scenario's seated pose, at rest."""
+    plant = scene.plant
+    instance = scene.robot.model_instance
+    init = scenario.initial
+    unknown = sorted(set(init.joints_rad) - set(scene.robot.joint_names))
+    if unknown:
+        from drake_standup.config import ScenarioError
+
+        raise ScenarioError(
+            f"initial.joints_rad: unknown joint(s) {', '.join(unknown)}; "
+            f"accepted: {', '.join(scene.robot.joint_names)}"
+        )
+    set_joint_positions(plant, plant_context, instance, init.joints_rad)
+    root = plant.GetBodyByName("root_link", instance)
+    plant.SetFreeBodyPose(
+        plant_context,
+        root,
+        RigidTransform(RollPitchYaw(init.base_rpy_rad), init.base_xyz_m),
+    )
+    plant.SetVelocities(plant_context, instance, 0.0 * plant.GetVelocities(plant_context, instance))

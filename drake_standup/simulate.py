@@ -1,0 +1,183 @@
+"""Run one scenario: build, simulate, collect metrics and outputs.
+
+The one function that run_diagram.py, the benchmark and the sweeps call.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from pydrake.geometry import Meshcat, MeshcatParams
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+from pydrake.systems.framework import EventStatus
+
+from drake_standup import outputs
+from drake_standup.config import Scenario
+from drake_standup.diagram import StandupDiagram, build_diagram
+from drake_standup.progress import ProgressBar
+from drake_standup.scene import set_seated_state
+
+GRAVITY_MPS2 = 9.81
+
+
+@dataclass
+class RunResult:
+    metrics: dict
+    files: dict[str, Path] = field(default_factory=dict)
+    times_s: np.ndarray | None = None
+    com_W: np.ndarray | None = None  # (3, N) CoM at the log times
+    pad_forces_W: np.ndarray | None = None  # (n_pads, 3, N)
+    pad_names: list[str] = field(default_factory=list)
+
+
+def make_meshcat() -> Meshcat:
+    """Meshcat on localhost only, on a free port (parallel runs don't clash)."""
+    return Meshcat(MeshcatParams(host="localhost", port=0, show_stats_plot=False))
+
+
+def simulate(
+    scenario: Scenario,
+    out_dir: Path | None = None,
+    *,
+    record: bool = True,
+    progress: bool = True,
+    chunk_s: float = 0.05,
+) -> RunResult:
+    """Simulates scenario; writes recording, metrics and diagram into out_dir."""
+    meshcat = make_meshcat() if record else None
+    t_build = time.perf_counter()
+    built = build_diagram(scenario, meshcat)
+    build_time_s = time.perf_counter() - t_build
+
+    simulator = Simulator(built.diagram)
+    ApplySimulatorConfig(scenario.simulator, simulator)
+    root_context = simulator.get_mutable_context()
+    plant = built.scene.plant
+    plant_context = plant.GetMyMutableContextFromRoot(root_context)
+    set_seated_state(built.scene, plant_context, scenario)
+
+    fall = _FallMonitor(built, scenario)
+    simulator.set_monitor(fall)
+    if meshcat is not None:
+        vis = scenario.visualization
+        meshcat.SetCameraPose(np.array(vis.camera_xyz_m), np.array(vis.target_xyz_m))
+        built.visualizer.StartRecording(set_transforms_while_recording=False)
+
+    failure_reason = None
+    bar = ProgressBar(scenario.duration_s, "simulating") if progress else None
+    t_wall = time.perf_counter()
+    try:
+        simulator.Initialize()
+        while root_context.get_time() < scenario.duration_s - 1e-9:
+            target = min(root_context.get_time() + chunk_s, scenario.duration_s)
+            status = simulator.AdvanceTo(target)
+            elapsed = time.perf_counter() - t_wall
+            if bar is not None:
+                rate = root_context.get_time() / max(elapsed, 1e-9)
+                bar.update(root_context.get_time(), f"{rate:.2f}x real time")
+            if status.reason() == status.ReturnReason.kReachedTerminationCondition:
+                failure_reason = fall.reason
+                break
+    except RuntimeError as err:
+        failure_reason = "simulation error: " + " ".join(str(err).split())[:300]
+    wall_time_s = time.perf_counter() - t_wall
+    if bar is not None:
+        bar.close()
+
+    result = _collect(built, root_context, scenario)
+    sim_time_s = root_context.get_time()
+    result.metrics.update(
+        success=failure_reason is None,
+        failure_reason=failure_reason,
+        sim_time_s=sim_time_s,
+        wall_time_s=wall_time_s,
+        realtime_factor=sim_time_s / wall_time_s if wall_time_s > 0 else None,
+        build_time_s=build_time_s,
+        robot_model=scenario.robot.model,
+    )
+    result.metrics = {k: result.metrics[k] for k in _ordered(result.metrics)}
+
+    if out_dir is not None:
+        out_dir = Path(out_dir)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        if meshcat is not None:
+            built.visualizer.StopRecording()
+            built.visualizer.PublishRecording()
+            path = out_dir / "recording.html"
+            result.metrics["recording_bytes"] = outputs.write_recording(meshcat, path)
+            result.files["recording"] = path
+        for p in outputs.export_diagram(built.diagram, out_dir / "diagrams"):
+            result.files[p.suffix.lstrip(".")] = p
+        path = out_dir / "metrics.json"
+        outputs.write_metrics(path, result.metrics)
+        result.files["metrics"] = path
+    return result
+
+
+def _ordered(metrics: dict) -> list[str]:
+    head = ["success", "failure_reason", "sim_time_s", "wall_time_s", "realtime_factor"]
+    return [k for k in head if k in metrics] + [k for k in metrics if k not in head]
+
+
+class _FallMonitor:
+    """Simulator monitor: stops the run when the robot has fallen.
+
+    Checks the floating base only (cheap each step): its height, and its
+    horizontal distance from where it started.
+    """
+
+    def __init__(self, built: StandupDiagram, scenario: Scenario):
+        self._plant = built.scene.plant
+        self._instance = built.scene.robot.model_instance
+        self._min_z = scenario.fall.min_root_height_m
+        self._max_xy = scenario.fall.max_com_horizontal_m
+        self._xy0 = np.array(scenario.initial.base_xyz_m[:2])
+        self.reason: str | None = None
+
+    def __call__(self, root_context) -> EventStatus:
+        context = self._plant.GetMyContextFromRoot(root_context)
+        q = self._plant.GetPositions(context, self._instance)
+        p_WB = q[4:7]  # floating base: quaternion (4), then position (3)
+        if p_WB[2] < self._min_z:
+            self.reason = (
+                f"fall: root_link height {p_WB[2]:.3f} m < {self._min_z} m "
+                f"at t = {root_context.get_time():.3f} s"
+            )
+        elif np.linalg.norm(p_WB[:2] - self._xy0) > self._max_xy:
+            self.reason = (
+                f"fall: root_link moved {np.linalg.norm(p_WB[:2] - self._xy0):.3f} m "
+                f"horizontally at t = {root_context.get_time():.3f} s"
+            )
+        if self.reason is not None:
+            return EventStatus.ReachedTermination(None, self.reason)
+        return EventStatus.DidNothing()
+
+
+def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResult:
+    """Reads the loggers into arrays and turns them into metrics."""
+    plant = built.scene.plant
+    instance = built.scene.robot.model_instance
+    state_log = built.state_log.FindLog(root_context)
+    force_log = built.pad_force_log.FindLog(root_context)
+    times = state_log.sample_times()
+    n_q = plant.num_positions(instance)
+    scratch = plant.CreateDefaultContext()
+    com = np.zeros((3, len(times)))
+    for k in range(len(times)):
+        plant.SetPositions(scratch, instance, state_log.data()[:n_q, k])
+        com[:, k] = plant.CalcCenterOfMassPositionInWorld(scratch, [instance])
+    pad_forces = force_log.data().reshape(len(built.pad_groups), 3, -1)
+    mass_kg = plant.CalcTotalMass(scratch, [instance])
+    metrics = outputs.seated_metrics(
+        times,
+        com,
+        force_log.sample_times(),
+        pad_forces,
+        built.pad_groups,
+        weight_N=mass_kg * GRAVITY_MPS2,
+    )
+    metrics["robot_mass_kg"] = mass_kg
+    return RunResult(metrics, {}, times, com, pad_forces, list(built.pad_groups))

@@ -1,0 +1,74 @@
+"""End-to-end: the iCub stays seated under the joint-space hold (issue 2)."""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from drake_standup.robot import original_urdf
+
+pytestmark = pytest.mark.slow
+
+G = 9.81
+
+
+def _urdf_mass_kg(model: str) -> float:
+    """Robot mass summed straight from the URDF, independently of Drake."""
+    root = ET.parse(original_urdf(model)).getroot()
+    return sum(float(m.get("value")) for m in root.iter("mass"))
+
+
+def test_run_succeeds_and_writes_outputs(seated_run):
+    _, result, out = seated_run
+    assert result.metrics["success"] is True
+    assert result.metrics["failure_reason"] is None
+    for name in ("recording.html", "metrics.json", "diagrams/standup.dot"):
+        assert (out / name).is_file(), name
+    metrics = json.loads((out / "metrics.json").read_text())
+    for key in ("success", "failure_reason", "sim_time_s", "wall_time_s", "realtime_factor"):
+        assert key in metrics
+    assert metrics["sim_time_s"] == pytest.approx(5.0, abs=1e-6)
+    assert metrics["realtime_factor"] > 0
+
+
+def test_com_stays_put_after_settling(seated_run):
+    """After the first 0.5 s the CoM moves less than 1 cm."""
+    _, result, _ = seated_run
+    after = result.times_s >= 0.5
+    com = result.com_W[:, after]
+    drift = np.linalg.norm(com - com[:, :1], axis=0).max()
+    assert drift < 0.01
+    assert result.metrics["com_drift_after_settle_m"] == pytest.approx(drift)
+
+
+def test_contact_forces_carry_the_robot_weight(seated_run):
+    """Soles, thighs and buttocks together carry m g (URDF mass) within 2%,
+    with no net horizontal force, and each group carries part of it."""
+    scenario, result, _ = seated_run
+    weight = _urdf_mass_kg(scenario.robot.model) * G
+    late = result.times_s >= 1.0
+    total = result.pad_forces_W.sum(axis=0)[:, late]  # (3, N)
+    assert np.all(np.abs(total[2] - weight) < 0.02 * weight)
+    assert np.all(np.abs(total[:2]) < 0.02 * weight)
+    groups = result.metrics["contact_normal_force_N"]
+    assert set(groups) == {"soles", "thighs", "buttocks"}
+    for name, fz in groups.items():
+        assert fz > 0.05 * weight, name
+
+
+def test_only_the_pads_touch_anything(seated_run):
+    """The robot's only collision geometries are the five pads, and every one
+    of them is in contact at the end (the pose really rests on chair and floor)."""
+    _, result, _ = seated_run
+    final = result.pad_forces_W[:, 2, -1]
+    assert set(result.pad_names) == {
+        "l_sole_pad",
+        "r_sole_pad",
+        "l_thigh_pad",
+        "r_thigh_pad",
+        "buttocks_pad",
+    }
+    assert np.all(final > 1.0)
