@@ -284,6 +284,7 @@ class Robot:
         "l_thigh": "l_upper_leg_contact",
         "r_thigh": "r_upper_leg_contact",
         "buttocks": "buttocks_contact",
+        "seat": "seat_contact",
     }
 
     def frame(self, plant: MultibodyPlant, task_name: str):
