@@ -12,8 +12,18 @@ import sys
 from pathlib import Path
 
 
+class _OneLineErrorParser(argparse.ArgumentParser):
+    """argparse, but a bad argument is one 'error:' line and exit code 2."""
+
+    def error(self, message: str) -> None:
+        print(f"error: {message}; see --help", file=sys.stderr)
+        sys.exit(2)
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = _OneLineErrorParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--scenario", type=Path, default=None, help="scenario YAML (default: scenarios/seated.yaml)")
     parser.add_argument("--out", type=Path, default=Path("out"), help="output directory (default: out/)")
     parser.add_argument("--duration", type=float, default=None, help="simulated seconds (overrides the scenario's duration_s)")

@@ -8,8 +8,11 @@ scenarios/ override what they name.
 
 
 import math
+import typing
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import yaml
 
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
@@ -82,6 +85,113 @@ class ChairConfig:
 
 
 @dataclass
+class Pull:
+    """A scripted pull on one hand: a trapezoid in time, constant direction."""
+
+    hand: str = "left"  # left | right
+    start_s: float = 3.0
+    duration_s: float = 6.0
+    # Linear ramp up at the start and down at the end, inside duration_s. s.
+    ramp_s: float = 0.5
+    # World frame; the robot faces +x, z is up. N.
+    force_N: list[float] = field(default_factory=lambda: [15.0, 0.0, 15.0])
+
+
+@dataclass
+class ReactiveHumanConfig:
+    """A helper who pulls each hand toward a target moving up and forward.
+
+    F = sat(K (p_target - p_hand) - D v_hand, force_cap_N), the target leaving
+    the hand's position at start_s with velocity target_velocity_mps for at most
+    travel_m; the pull fades in and out over ramp_s (SPEC 3: 10-25 N per hand).
+    """
+
+    start_s: float = 3.0
+    duration_s: float = 8.0
+    ramp_s: float = 0.5
+    # Arm-like stiffness and damping of a person guiding a hand. N/m, N s/m.
+    stiffness_N_per_m: float = 150.0
+    damping_Ns_per_m: float = 20.0
+    # Per hand; the authors' human pulled 10-25 N (SPEC 3). N.
+    force_cap_N: float = 20.0
+    target_velocity_mps: list[float] = field(default_factory=lambda: [0.10, 0.0, 0.10])
+    travel_m: float = 0.35
+
+
+@dataclass
+class HumanConfig:
+    # scripted: the pulls below; reactive: the impedance helper (reactive:).
+    mode: str = "scripted"
+    # Empty list: nobody helps.
+    pulls: list[Pull] = field(default_factory=list)
+    reactive: ReactiveHumanConfig = field(default_factory=ReactiveHumanConfig)
+
+
+@dataclass
+class AdvancementConfig:
+    # false: psi = t (the plain time-parametrised controller).
+    enabled: bool = True
+    # tangent: the paper's proposition, psi_dot = clip(xdot . d_psi x_d /
+    #   (|d_psi x_d|^2 + eps)), applied while the interaction helps (alpha >
+    #   alpha_min). interaction: the authors' code, the same ratio measured along
+    #   Omega f (SPEC 2).
+    law: str = "tangent"
+    # Upper bound of psi_dot; the authors' last setting (earlier 5). SPEC 3.
+    psi_dot_upper: float = 2.5
+    # Regulariser of the denominators, m^2 (per unit psi^2): 0.4% of the
+    # squared peak tangent of the state-2 segment (|d_psi x_d| <= 0.16 m), so it
+    # only matters where the tangent vanishes, at the ends of each segment.
+    eps: float = 1.0e-4
+    # alpha (hand-induced CoM acceleration along the path) above which the
+    # interaction counts as helpful: ~1.6 N of net pull along the path. m/s^2.
+    alpha_min_mps2: float = 0.05
+    # Time constant of the psi_dot filter whose derivative feeds xd_ddot. s.
+    psi_ddot_filter_s: float = 0.05
+
+
+@dataclass
+class StandupConfig:
+    """The stand-up state machine and its CoM segments (SPEC 3, 7)."""
+
+    # hands: state 1 -> 2 needs the pull (both hands, x force > threshold);
+    # time: after the balancing time alone.
+    trigger: str = "hands"
+    # Minimum time balancing seated in state 1 (SPEC 3). s.
+    balance_time_s: float = 3.0
+    # x component of the force on each hand that starts the stand-up. N.
+    hand_force_threshold_N: float = 10.0
+    # Min-jerk segment lengths of states 2, 3, 4 in units of psi (= s when
+    # psi = t); the advancement version's [1.5, 0.5, 1.8] (SPEC 3).
+    segment_psi: list[float] = field(default_factory=lambda: [1.5, 0.5, 1.8])
+    # CoM displacement of state 2 (SPEC 3: [0.1277, -0.0295, 0]; the lateral
+    # part belonged to the authors' asymmetric posture, ours is symmetric). m.
+    state2_com_delta_m: list[float] = field(default_factory=lambda: [0.1277, 0.0, 0.0])
+    # CoM displacement of state 3 (SPEC 3). m.
+    state3_com_delta_m: list[float] = field(default_factory=lambda: [0.04, 0.0, 0.0])
+    # State 4 rises to an absolute CoM height: "+0.20 m" is out of reach on
+    # this model (0.376 m seated, ~0.55 m straight-legged); 0.526 m worked in
+    # the feasibility probe (SPEC 7). m.
+    standing_com_height_m: float = 0.526
+    # 2 -> 3: feet carry this much together (SPEC 3)... N
+    feet_force_2to3_N: float = 150.0
+    # ... after at least this long in state 2 (SPEC 3)... s
+    min_time_state2_s: float = 1.5
+    # ... with the CoM this far in front of the soles' heel edge (SPEC 7:
+    # feet forces alone fired with the CoM behind the heels). m.
+    com_ahead_of_heels_m: float = 0.03
+    # 3 -> 4: each foot carries this much (SPEC 3)... N
+    foot_force_3to4_N: float = 95.0
+    # ... after at least this long in state 3 (SPEC 3). s
+    min_time_state3_s: float = 0.5
+    # The seat's normal-force bound ramps to zero over this time after the
+    # switch to state 3 (SPEC 7). s.
+    seat_release_s: float = 1.0
+    # Period of the state machine's update; the authors' whole controller ran
+    # at 100 Hz (SPEC 3), and the guards' thresholds are met for seconds. s.
+    update_period_s: float = 0.01
+
+
+@dataclass
 class SeatHoldConfig:
     """Joint-space hold: Drake's implicit joint PD plus gravity feed-forward.
 
@@ -128,11 +238,21 @@ class Scenario:
             contact_model="hydroelastic_with_fallback",
         )
     )
-    # Drake's simulator settings; the plant is discrete, so the integrator only
-    # matters for continuous states of our own systems. Run as fast as possible.
+    # Drake's simulator settings. The plant is discrete (1 ms); the only
+    # continuous state is psi (and its filter), whose derivative is constant
+    # between plant steps but for the reference tangent: fixed 1 ms RK2 steps.
+    # Run as fast as possible.
     simulator: SimulatorConfig = field(
-        default_factory=lambda: SimulatorConfig(target_realtime_rate=0.0)
+        default_factory=lambda: SimulatorConfig(
+            integration_scheme="runge_kutta2",
+            max_step_size=0.001,
+            use_error_control=False,
+            target_realtime_rate=0.0,
+        )
     )
+    human: HumanConfig = field(default_factory=HumanConfig)
+    advancement: AdvancementConfig = field(default_factory=AdvancementConfig)
+    standup: StandupConfig = field(default_factory=StandupConfig)
     initial: InitialPose = field(default_factory=InitialPose)
     chair: ChairConfig = field(default_factory=ChairConfig)
     seat_hold: SeatHoldConfig = field(default_factory=SeatHoldConfig)
@@ -151,18 +271,85 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
             f"{', '.join(str(p.relative_to(REPO_ROOT)) for p in sorted(SCENARIO_DIR.glob('*.yaml')))}"
         )
     try:
+        raw = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as err:
+        raise ScenarioError(f"scenario {path}: not valid YAML ({_one_line(err)})") from None
+    if raw is None:
+        raw = {}
+    _check_schema("", raw, Scenario)
+    try:
         scenario = yaml_load_typed(schema=Scenario, filename=str(path))
-    except RuntimeError as err:
-        raise ScenarioError(f"scenario {path}: {_first_line(err)}") from None
+    except (RuntimeError, ValueError, TypeError) as err:
+        raise ScenarioError(f"scenario {path}: {_one_line(err)}") from None
     validate(scenario)
     return scenario
 
 
-def _first_line(err: Exception) -> str:
+def _one_line(err: Exception) -> str:
     return " ".join(str(err).split())
 
 
+def _fields(schema) -> dict[str, typing.Any] | None:
+    """Field name -> type of one of our dataclasses or one of Drake's structs."""
+    if hasattr(schema, "__dataclass_fields__"):
+        hints = typing.get_type_hints(schema)
+        return {name: hints[name] for name in schema.__dataclass_fields__}
+    if hasattr(schema, "__fields__"):  # Drake's C++ config structs
+        return {f.name: f.type for f in schema.__fields__}
+    return None
+
+
+def _type_name(kind) -> str:
+    return {float: "a number", int: "an integer", bool: "true or false", str: "a string"}.get(
+        kind, getattr(kind, "__name__", str(kind))
+    )
+
+
+def _check_schema(path: str, value, schema) -> None:
+    """Names the key path of the first unknown key or mistyped value.
+
+    Drake's loader rejects both too, but without saying where (or, for a
+    string in a number field, with a bare ValueError).
+    """
+    where = path or "scenario"
+    fields = _fields(schema)
+    if fields is not None:
+        if not isinstance(value, dict):
+            raise ScenarioError(f"{where}: {value!r}; accepted: a mapping of {', '.join(fields)}")
+        for key, item in value.items():
+            if key not in fields:
+                raise ScenarioError(
+                    f"{path + '.' if path else ''}{key}: unknown key; "
+                    f"accepted: {', '.join(fields)}"
+                )
+            _check_schema(f"{path + '.' if path else ''}{key}", item, fields[key])
+        return
+    origin = typing.get_origin(schema)
+    args = typing.get_args(schema)
+    if origin is list:
+        if not isinstance(value, list):
+            raise ScenarioError(f"{where}: {value!r}; accepted: a list")
+        for i, item in enumerate(value):
+            _check_schema(f"{path}[{i}]", item, args[0])
+    elif origin is dict:
+        if not isinstance(value, dict):
+            raise ScenarioError(f"{where}: {value!r}; accepted: a mapping")
+        for key, item in value.items():
+            _check_schema(f"{path}.{key}", item, args[1])
+    elif origin in (typing.Union, getattr(__import__("types"), "UnionType", None)):
+        if value is not None:
+            _check_schema(path, value, next(a for a in args if a is not type(None)))
+    elif schema is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ScenarioError(f"{where}: {value!r}; accepted: {_type_name(float)}")
+    elif schema in (int, bool, str):
+        if not isinstance(value, schema) or (schema is int and isinstance(value, bool)):
+            raise ScenarioError(f"{where}: {value!r}; accepted: {_type_name(schema)}")
+
+
 def _check_finite(prefix: str, obj) -> None:
+    if isinstance(obj, bool):
+        return
     if isinstance(obj, float):
         if not math.isfinite(obj):
             raise ScenarioError(f"{prefix}: {obj} is not finite; accepted: a finite number")
@@ -172,8 +359,8 @@ def _check_finite(prefix: str, obj) -> None:
     elif isinstance(obj, dict):
         for key, item in obj.items():
             _check_finite(f"{prefix}.{key}", item)
-    elif hasattr(obj, "__dataclass_fields__"):
-        for name in obj.__dataclass_fields__:
+    elif (fields := _fields(type(obj))) is not None:
+        for name in fields:
             _check_finite(f"{prefix}.{name}" if prefix else name, getattr(obj, name))
 
 
@@ -192,13 +379,90 @@ def validate(scenario: Scenario) -> None:
     _positive("robot.effort_limit_Nm", scenario.robot.effort_limit_Nm)
     _positive("log_period_s", scenario.log_period_s, allow_zero=False)
     _positive("visualization.publish_period_s", scenario.visualization.publish_period_s)
-    for key, n in (("initial.base_xyz_m", 3), ("initial.base_rpy_rad", 3)):
-        value = getattr(scenario.initial, key.split(".")[1])
-        if len(value) != n:
-            raise ScenarioError(f"{key}: {len(value)} values; accepted: a list of {n}")
+    _positive("robot.visual_max_faces", scenario.robot.visual_max_faces)
+    if not _resolve(scenario.chair.file).is_file():
+        raise ScenarioError(
+            f"chair.file: '{scenario.chair.file}' not found; accepted: an SDF file path "
+            "(relative to the repository or absolute), e.g. models/chair.sdf"
+        )
+    _length("initial.base_xyz_m", scenario.initial.base_xyz_m, 3)
+    _length("initial.base_rpy_rad", scenario.initial.base_rpy_rad, 3)
+    _validate_human(scenario.human)
+    _validate_advancement(scenario.advancement)
+    _validate_standup(scenario.standup)
+
+
+def _resolve(path: str) -> Path:
+    """A path from a scenario: absolute, or relative to the repository."""
+    p = Path(path)
+    return p if p.is_absolute() else REPO_ROOT / p
+
+
+def _length(key: str, value: list, n: int) -> None:
+    if len(value) != n:
+        raise ScenarioError(f"{key}: {len(value)} values; accepted: a list of {n} numbers")
+
+
+def _choice(key: str, value: str, accepted: tuple[str, ...]) -> None:
+    if value not in accepted:
+        raise ScenarioError(f"{key}: '{value}' unknown; accepted: {' | '.join(accepted)}")
+
+
+def _validate_human(human: HumanConfig) -> None:
+    _choice("human.mode", human.mode, ("scripted", "reactive"))
+    for i, pull in enumerate(human.pulls):
+        key = f"human.pulls[{i}]"
+        _choice(f"{key}.hand", pull.hand, ("left", "right"))
+        _positive(f"{key}.start_s", pull.start_s, allow_zero=True)
+        _positive(f"{key}.duration_s", pull.duration_s)
+        _positive(f"{key}.ramp_s", pull.ramp_s, allow_zero=True)
+        if 2 * pull.ramp_s > pull.duration_s:
+            raise ScenarioError(
+                f"{key}.ramp_s: {pull.ramp_s}; accepted: at most half of duration_s "
+                f"({pull.duration_s / 2})"
+            )
+        _length(f"{key}.force_N", pull.force_N, 3)
+    r = human.reactive
+    for name in ("start_s", "ramp_s", "stiffness_N_per_m", "damping_Ns_per_m", "travel_m"):
+        _positive(f"human.reactive.{name}", getattr(r, name), allow_zero=True)
+    _positive("human.reactive.duration_s", r.duration_s)
+    _positive("human.reactive.force_cap_N", r.force_cap_N)
+    _length("human.reactive.target_velocity_mps", r.target_velocity_mps, 3)
+
+
+def _validate_advancement(adv: AdvancementConfig) -> None:
+    _choice("advancement.law", adv.law, ("tangent", "interaction"))
+    if adv.psi_dot_upper < 1.0:
+        raise ScenarioError(
+            f"advancement.psi_dot_upper: {adv.psi_dot_upper}; accepted: a number >= 1"
+        )
+    _positive("advancement.eps", adv.eps)
+    _positive("advancement.alpha_min_mps2", adv.alpha_min_mps2, allow_zero=True)
+    _positive("advancement.psi_ddot_filter_s", adv.psi_ddot_filter_s)
+
+
+def _validate_standup(st: StandupConfig) -> None:
+    _choice("standup.trigger", st.trigger, ("hands", "time"))
+    _length("standup.segment_psi", st.segment_psi, 3)
+    for i, value in enumerate(st.segment_psi):
+        _positive(f"standup.segment_psi[{i}]", value)
+    _length("standup.state2_com_delta_m", st.state2_com_delta_m, 3)
+    _length("standup.state3_com_delta_m", st.state3_com_delta_m, 3)
+    for name in (
+        "balance_time_s",
+        "hand_force_threshold_N",
+        "feet_force_2to3_N",
+        "min_time_state2_s",
+        "foot_force_3to4_N",
+        "min_time_state3_s",
+        "seat_release_s",
+    ):
+        _positive(f"standup.{name}", getattr(st, name), allow_zero=True)
+    _positive("standup.standing_com_height_m", st.standing_com_height_m)
+    _positive("standup.update_period_s", st.update_period_s)
 
 
 def _positive(key: str, value: float, allow_zero: bool = False) -> None:
-    if value < 0 or (value == 0 and not allow_zero):
+    if not (value >= 0 if allow_zero else value > 0):
         accepted = "a number >= 0" if allow_zero else "a number > 0"
         raise ScenarioError(f"{key}: {value}; accepted: {accepted}")

@@ -10,9 +10,14 @@ from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
 
+from drake_standup.advancement import TrajectoryAdvancement
 from drake_standup.config import Scenario
 from drake_standup.contacts import ContactForceReporter
+from drake_standup.human import HumanWrenchSource
+from drake_standup.reference import CoMReferenceGenerator
 from drake_standup.scene import Scene, add_scene, set_seated_state
+from drake_standup.sensing import RobotSensing, heel_points
+from drake_standup.state_machine import StandupStateMachine
 
 
 @dataclass
@@ -22,8 +27,8 @@ class StandupDiagram:
     diagram: Diagram
     scene: Scene
     pad_groups: dict[str, str]  # pad geometry name -> group, in reporter order
-    state_log: VectorLogSink
-    pad_force_log: VectorLogSink
+    state_machine: StandupStateMachine
+    logs: dict[str, VectorLogSink]  # signal name -> logger
     visualizer: MeshcatVisualizer | None
 
 
@@ -71,10 +76,60 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
     )
     builder.Connect(plant.get_contact_results_output_port(), reporter.get_input_port())
 
-    state_log = LogVectorOutput(plant.get_state_output_port(instance), builder, scenario.log_period_s)
-    state_log.set_name("state_logger")
-    pad_force_log = LogVectorOutput(reporter.get_output_port(), builder, scenario.log_period_s)
-    pad_force_log.set_name("pad_force_logger")
+    robot = scene.robot
+    human = builder.AddNamedSystem(
+        "human", HumanWrenchSource(plant, robot, scenario.human)
+    )
+    sensing = builder.AddNamedSystem(
+        "sensing", RobotSensing(plant, robot, heel_points(robot))
+    )
+    advancement = builder.AddNamedSystem(
+        "advancement", TrajectoryAdvancement(scenario.advancement)
+    )
+    reference = builder.AddNamedSystem("com_reference", CoMReferenceGenerator())
+    sole_rows = tuple(
+        pad_names.index(s.name)
+        for frame in ("l_sole", "r_sole")
+        for s in robot.contact_shapes
+        if s.frame == frame
+    )
+    state_machine = builder.AddNamedSystem(
+        "state_machine", StandupStateMachine(scenario.standup, len(pad_names), sole_rows)
+    )
+
+    robot_state = plant.get_state_output_port(instance)
+    hand_wrenches = human.GetOutputPort("hand_wrenches_W")
+    builder.Connect(human.GetOutputPort("spatial_forces"), plant.get_applied_spatial_force_input_port())
+    builder.Connect(robot_state, human.GetInputPort("robot_state"))
+    builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
+    builder.Connect(hand_wrenches, sensing.GetInputPort("hand_wrenches_W"))
+    for name in ("com_velocity_W", "omega_f_W"):
+        builder.Connect(sensing.GetOutputPort(name), advancement.GetInputPort(name))
+    builder.Connect(reference.GetOutputPort("path_tangent_W"), advancement.GetInputPort("path_tangent_W"))
+    for name in ("psi", "psi_dot", "psi_ddot"):
+        builder.Connect(advancement.GetOutputPort(name), reference.GetInputPort(name))
+    builder.Connect(state_machine.GetOutputPort("segment"), reference.GetInputPort("segment"))
+    builder.Connect(advancement.GetOutputPort("psi"), state_machine.GetInputPort("psi"))
+    builder.Connect(sensing.GetOutputPort("com_W"), state_machine.GetInputPort("com_W"))
+    builder.Connect(sensing.GetOutputPort("heel_x_W"), state_machine.GetInputPort("heel_x_W"))
+    builder.Connect(reporter.get_output_port(), state_machine.GetInputPort("pad_forces_W"))
+    builder.Connect(hand_wrenches, state_machine.GetInputPort("hand_wrenches_W"))
+
+    logged = {
+        "robot_state": robot_state,
+        "pad_forces_W": reporter.get_output_port(),
+        "hand_wrenches_W": hand_wrenches,
+        "com_W": sensing.GetOutputPort("com_W"),
+        "psi": advancement.GetOutputPort("psi"),
+        "psi_dot": advancement.GetOutputPort("psi_dot"),
+        "alpha": advancement.GetOutputPort("alpha"),
+        "com_reference": reference.GetOutputPort("com_reference"),
+        "standup_state": state_machine.GetOutputPort("standup_state"),
+    }
+    logs = {}
+    for name, port in logged.items():
+        logs[name] = LogVectorOutput(port, builder, scenario.log_period_s)
+        logs[name].set_name(f"log_{name}")
 
     visualizer = None
     if meshcat is not None:
@@ -97,7 +152,7 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
 
     diagram = builder.Build()
     diagram.set_name("standup")
-    return StandupDiagram(diagram, scene, pad_groups, state_log, pad_force_log, visualizer)
+    return StandupDiagram(diagram, scene, pad_groups, state_machine, logs, visualizer)
 
 
 class _AllJoints(dict):

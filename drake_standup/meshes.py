@@ -81,7 +81,7 @@ def write_obj(path: Path, vertices: np.ndarray, faces: np.ndarray, scale) -> Non
     lines = ["# converted by drake_standup from a third-party STL; do not commit\n"]
     lines += [f"v {x:.4f} {y:.4f} {z:.4f}\n" for x, y, z in v]
     lines += [f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces]
-    tmp = path.with_suffix(".tmp")
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
     tmp.write_text("".join(lines))
     tmp.replace(path)
 
@@ -91,6 +91,7 @@ def converted_obj(stl_path: Path, scale, max_faces: int) -> Path:
     stl_path = Path(stl_path)
     key = hashlib.sha1(
         f"{_CONVERTER_VERSION}|{stl_path.resolve()}|{stl_path.stat().st_size}|"
+        f"{stl_path.stat().st_mtime_ns}|"
         f"{list(scale)}|{max_faces}".encode()
     ).hexdigest()[:12]
     out = cache_dir() / "meshes" / f"{stl_path.stem}-{key}.obj"

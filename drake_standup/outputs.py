@@ -61,7 +61,6 @@ def export_diagram(diagram: Diagram, directory: Path, stem: str = "standup") -> 
 def seated_metrics(
     times_s: np.ndarray,
     com_W: np.ndarray,
-    force_times_s: np.ndarray,
     pad_forces_W: np.ndarray,
     pad_groups: dict[str, str],
     weight_N: float,
@@ -92,3 +91,17 @@ def seated_metrics(
         metrics["contact_normal_force_N"] = by_group
         metrics["contact_force_total_N"] = final.sum(axis=0)
     return metrics
+
+
+def advancement_metrics(
+    psi: np.ndarray, psi_dot: np.ndarray, entry_times_s: tuple[float, ...]
+) -> dict:
+    """psi at the end, the range of psi_dot, when each state was entered."""
+    if len(psi) == 0:
+        return {}
+    return {
+        "psi_final": float(psi[-1]),
+        "psi_dot_min": float(np.min(psi_dot)),
+        "psi_dot_max": float(np.max(psi_dot)),
+        "state_entry_times_s": [None if np.isnan(t) else float(t) for t in entry_times_s],
+    }

@@ -15,6 +15,7 @@ What this module does to the published URDF, in order:
 
 
 import hashlib
+import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -149,7 +150,10 @@ def prepare_urdf(
     out = cache_dir() / "urdf" / f"{model_name}-{kind}-{digest}.urdf"
     if not out.exists():
         out.parent.mkdir(parents=True, exist_ok=True)
-        tree.write(out)
+        # Write then rename: a half-written file must never look cached.
+        tmp = out.with_name(f"{out.name}.{os.getpid()}.tmp")
+        tree.write(tmp)
+        tmp.replace(out)
     return PreparedUrdf(out, leaf_frames)
 
 
@@ -273,6 +277,7 @@ class Robot:
     joint_names: list[str]  # revolute joints, in actuator order
     contact_groups: dict[str, list[str]]  # group -> contact geometry names
     contact_geometries: dict[str, GeometryId]  # contact geometry name -> id
+    contact_shapes: list[ContactShape]
     leaf_frames: list[LeafFrame]
 
     # Task frame -> model frame: the controller speaks of hands and soles.
@@ -360,7 +365,13 @@ def add_icub(
             )
             groups.setdefault(spec.group, []).append(spec.name)
     return Robot(
-        instance, model_name, joint_names, groups, geometries, prepared.leaf_frames
+        instance,
+        model_name,
+        joint_names,
+        groups,
+        geometries,
+        list(contact.shapes),
+        prepared.leaf_frames,
     )
 
 

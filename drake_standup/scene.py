@@ -4,7 +4,6 @@ and a floor, hydroelastic contact, and the robot's seated initial state."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, SceneGraph
 from pydrake.math import RigidTransform, RollPitchYaw
@@ -12,7 +11,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.systems.framework import Context, DiagramBuilder
 
-from drake_standup.config import REPO_ROOT, Scenario
+from drake_standup.config import REPO_ROOT, Scenario, _resolve
 from drake_standup.robot import Robot, add_icub, set_joint_positions
 
 MODELS_DIR = REPO_ROOT / "models"
@@ -62,11 +61,6 @@ def add_scene(
         CollisionFilterDeclaration().ExcludeWithin(robot_geometries)
     )
     return Scene(plant, scene_graph, robot)
-
-
-def _resolve(path: str) -> Path:
-    p = Path(path)
-    return p if p.is_absolute() else REPO_ROOT / p
 
 
 def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -> None:

@@ -156,28 +156,30 @@ class _FallMonitor:
         return EventStatus.DidNothing()
 
 
+def _log(built: StandupDiagram, root_context, name: str):
+    return built.logs[name].FindLog(root_context)
+
+
 def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResult:
     """Reads the loggers into arrays and turns them into metrics."""
     plant = built.scene.plant
     instance = built.scene.robot.model_instance
-    state_log = built.state_log.FindLog(root_context)
-    force_log = built.pad_force_log.FindLog(root_context)
-    times = state_log.sample_times()
-    n_q = plant.num_positions(instance)
-    scratch = plant.CreateDefaultContext()
-    com = np.zeros((3, len(times)))
-    for k in range(len(times)):
-        plant.SetPositions(scratch, instance, state_log.data()[:n_q, k])
-        com[:, k] = plant.CalcCenterOfMassPositionInWorld(scratch, [instance])
-    pad_forces = force_log.data().reshape(len(built.pad_groups), 3, -1)
-    mass_kg = plant.CalcTotalMass(scratch, [instance])
+    com_log = _log(built, root_context, "com_W")
+    times = com_log.sample_times()
+    com = com_log.data()
+    pad_forces = _log(built, root_context, "pad_forces_W").data()
+    pad_forces = pad_forces.reshape(len(built.pad_groups), 3, -1)
+    mass_kg = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
     metrics = outputs.seated_metrics(
-        times,
-        com,
-        force_log.sample_times(),
-        pad_forces,
-        built.pad_groups,
-        weight_N=mass_kg * GRAVITY_MPS2,
+        times, com, pad_forces, built.pad_groups, weight_N=mass_kg * GRAVITY_MPS2
     )
     metrics["robot_mass_kg"] = mass_kg
+    sm_context = built.state_machine.GetMyContextFromRoot(root_context)
+    metrics.update(
+        outputs.advancement_metrics(
+            _log(built, root_context, "psi").data()[0],
+            _log(built, root_context, "psi_dot").data()[0],
+            built.state_machine.mode(sm_context).entry_times_s,
+        )
+    )
     return RunResult(metrics, {}, times, com, pad_forces, list(built.pad_groups))

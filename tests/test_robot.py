@@ -128,9 +128,7 @@ def test_total_mass_matches_urdf(plants, reduce):
     plant, robot, context = plants[reduce]
     expected = _urdf_total_mass()
     assert expected > 30.0  # the iCub is about 33 kg: guards an empty parse
-    assert plant.CalcTotalMass(context, [robot.model_instance]) == pytest.approx(
-        expected, abs=TOL
-    )
+    assert plant.CalcTotalMass(context, [robot.model_instance]) == pytest.approx(expected, abs=TOL)
 
 
 @pytest.mark.parametrize("reduce", [True, False], ids=["reduced", "full"])
@@ -228,8 +226,9 @@ def same_state(request, plants):
     """Sets one random state (by joint name and on root_link) in both plants."""
     rng = np.random.default_rng(request.param)
     quaternion = rng.normal(size=4)
-    X_WB = RigidTransform(Quaternion(quaternion / np.linalg.norm(quaternion)),
-                          rng.uniform(-1.0, 1.0, 3))
+    X_WB = RigidTransform(
+        Quaternion(quaternion / np.linalg.norm(quaternion)), rng.uniform(-1.0, 1.0, 3)
+    )
     V_WB = SpatialVelocity(w=rng.normal(size=3), v=rng.normal(size=3))
     full_plant, full_robot, _ = plants[False]
     q, v = {}, {}
@@ -334,7 +333,9 @@ def _geometry_pose(plant, context, inspector, gid) -> RigidTransform:
 
 def _box_corners_W(X_WG: RigidTransform, box: Box) -> np.ndarray:
     half = np.array([box.width(), box.depth(), box.height()]) / 2
-    return np.array([X_WG.multiply(np.array(s) * half) for s in itertools.product((-1, 1), repeat=3)])
+    return np.array(
+        [X_WG.multiply(np.array(s) * half) for s in itertools.product((-1, 1), repeat=3)]
+    )
 
 
 def test_pads_are_hydroelastic_boxes_as_in_yaml(seated):
@@ -349,6 +350,8 @@ def test_pads_are_hydroelastic_boxes_as_in_yaml(seated):
         props = inspector.GetProximityProperties(gid)
         assert props is not None, spec["name"]
         assert props.HasProperty("hydroelastic", "compliance_type"), spec["name"]
+        # Compliant, not rigid: only compliant hydroelastic geometry has a modulus.
+        assert props.HasProperty("hydroelastic", "hydroelastic_modulus"), spec["name"]
         assert props.GetProperty("hydroelastic", "hydroelastic_modulus") == pytest.approx(
             CONTACT_YAML["hydroelastic_modulus_Pa"]
         )

@@ -1,0 +1,107 @@
+"""TrajectoryAdvancement: the free parameter psi as continuous state.
+
+psi(0) = 0 and, while the human's interaction helps,
+    psi_dot = min{ psi_dot_upper, max{ 1, ratio } }
+with (SPEC 2; t = d_psi x_d the path tangent, Omega f the CoM acceleration the
+measured hand wrenches cause, xdot the measured CoM velocity):
+    tangent law (the paper's proposition):   ratio = xdot.t / (|t|^2 + eps)
+    interaction law (the authors' code):     ratio = (xdot.Omega f)(t.Omega f)
+                                                     / ((t.Omega f)^2 + eps)
+The interaction helps when alpha = t.Omega f / |t| (the part of Omega f along
+the desired velocity) exceeds alpha_min; otherwise, and with advancement
+disabled, psi_dot = 1 and psi = t. psi therefore never runs backwards nor
+faster than psi_dot_upper.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydrake.systems.framework import BasicVector, Context, ContinuousState, LeafSystem
+
+from drake_standup.config import AdvancementConfig
+
+
+def helpfulness(tangent: np.ndarray, omega_f: np.ndarray, eps: float) -> float:
+    """alpha: Omega f projected on the desired direction (0 where the path stops)."""
+    t2 = float(tangent @ tangent)
+    if t2 <= eps:
+        return 0.0
+    return float(tangent @ omega_f) / math.sqrt(t2)
+
+
+def psi_dot_law(
+    config: AdvancementConfig,
+    com_velocity: np.ndarray,
+    omega_f: np.ndarray,
+    tangent: np.ndarray,
+) -> tuple[float, float]:
+    """(psi_dot, alpha) by the configured update law."""
+    alpha = helpfulness(tangent, omega_f, config.eps)
+    if not config.enabled or alpha <= config.alpha_min_mps2:
+        return 1.0, alpha
+    if config.law == "tangent":
+        ratio = float(com_velocity @ tangent) / (float(tangent @ tangent) + config.eps)
+    else:
+        along = float(tangent @ omega_f)
+        ratio = float(com_velocity @ omega_f) * along / (along * along + config.eps)
+    return min(config.psi_dot_upper, max(1.0, ratio)), alpha
+
+
+class TrajectoryAdvancement(LeafSystem):
+    """Inputs com_velocity_W, omega_f_W, path_tangent_W (3 each).
+
+    Continuous state [psi, psi_dot_f]: psi integrates the law; psi_dot_f is
+    psi_dot low-passed (time constant psi_ddot_filter_s), whose derivative is
+    the psi_ddot the reference's feed-forward acceleration needs (the law
+    itself is not differentiable where it saturates or the gate switches).
+    Outputs psi, psi_dot, psi_ddot, alpha (1 each).
+    """
+
+    def __init__(self, config: AdvancementConfig):
+        super().__init__()
+        self._config = config
+        self.DeclareContinuousState(BasicVector([0.0, 1.0]))
+        self._v = self.DeclareVectorInputPort("com_velocity_W", 3)
+        self._omega_f = self.DeclareVectorInputPort("omega_f_W", 3)
+        self._tangent = self.DeclareVectorInputPort("path_tangent_W", 3)
+        self.DeclareVectorOutputPort(
+            "psi",
+            1,
+            self._CalcPsi,
+            prerequisites_of_calc={self.all_state_ticket()},
+        )
+        self.DeclareVectorOutputPort("psi_dot", 1, self._CalcPsiDot)
+        self.DeclareVectorOutputPort("psi_ddot", 1, self._CalcPsiDdot)
+        self.DeclareVectorOutputPort("alpha", 1, self._CalcAlpha)
+
+    def _law(self, context: Context) -> tuple[float, float]:
+        return psi_dot_law(
+            self._config,
+            self._v.Eval(context),
+            self._omega_f.Eval(context),
+            self._tangent.Eval(context),
+        )
+
+    def _psi_ddot(self, context: Context, psi_dot: float) -> float:
+        psi_dot_f = context.get_continuous_state_vector().GetAtIndex(1)
+        return (psi_dot - psi_dot_f) / self._config.psi_ddot_filter_s
+
+    def DoCalcTimeDerivatives(self, context: Context, derivatives: ContinuousState) -> None:
+        psi_dot, _ = self._law(context)
+        derivatives.get_mutable_vector().SetFromVector(
+            [psi_dot, self._psi_ddot(context, psi_dot)]
+        )
+
+    def _CalcPsi(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, context.get_continuous_state_vector().GetAtIndex(0))
+
+    def _CalcPsiDot(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self._law(context)[0])
+
+    def _CalcPsiDdot(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self._psi_ddot(context, self._law(context)[0]))
+
+    def _CalcAlpha(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self._law(context)[1])

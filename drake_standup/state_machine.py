@@ -1,0 +1,209 @@
+"""StandupStateMachine: the four states of the stand-up and their guards.
+
+    1 balance seated     -> 2 after balance_time_s, and with trigger 'hands'
+                              once both hands feel a forward pull > threshold
+    2 CoM forward        -> 3 after min_time_state2_s, the state-2 segment done,
+                              feet normal forces together > feet_force_2to3_N,
+                              the CoM >= com_ahead_of_heels_m in front of the heels
+    3 CoM forward, seat released over seat_release_s
+                         -> 4 after min_time_state3_s, the segment done, each
+                              foot's normal force > foot_force_3to4_N
+    4 CoM up to standing (final)
+(SPEC 3 and 7.) "Segment done" (psi past the segment's end) keeps the
+reference's slope continuous across switches; with psi_dot >= 1 it costs
+nothing when the dwell time is at least the segment length. One switch per
+update at most, so no state is ever skipped.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.common.value import Value
+from pydrake.systems.framework import BasicVector, Context, LeafSystem, State
+
+from drake_standup.config import StandupConfig
+from drake_standup.reference import SEGMENT_SIZE
+
+N_STATES = 4
+
+
+@dataclass(frozen=True)
+class StandupMode:
+    """The machine's abstract state: where it is and the active CoM segment."""
+
+    state: int = 1
+    entry_times_s: tuple[float, ...] = (0.0,) + (math.nan,) * (N_STATES - 1)
+    psi_entry: float = 0.0
+    segment_psi: float = 1.0
+    x_start_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    delta_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def segment(self) -> np.ndarray:
+        return np.array([self.psi_entry, self.segment_psi, *self.x_start_m, *self.delta_m])
+
+    def segment_end(self) -> np.ndarray:
+        return np.array(self.x_start_m) + np.array(self.delta_m)
+
+
+@dataclass(frozen=True)
+class Measurements:
+    """What the guards read: time, psi, CoM, heel edge, feet and hand forces."""
+
+    t: float
+    psi: float
+    com_W: np.ndarray
+    heel_x: float
+    foot_fz_N: tuple[float, float]  # left, right
+    hand_fx_N: tuple[float, float]  # left, right
+
+
+def initial_mode(com0_W: np.ndarray) -> StandupMode:
+    """State 1 at t = 0, holding the CoM where it starts."""
+    return StandupMode(x_start_m=tuple(float(c) for c in com0_W))
+
+
+def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> StandupMode:
+    """The mode after one update: the same, or the next state."""
+    dwell = m.t - mode.entry_times_s[mode.state - 1]
+    segment_done = m.psi - mode.psi_entry >= mode.segment_psi
+    if mode.state == 1:
+        pulled = min(m.hand_fx_N) > cfg.hand_force_threshold_N
+        go = dwell >= cfg.balance_time_s and (cfg.trigger == "time" or pulled)
+    elif mode.state == 2:
+        go = (
+            dwell >= cfg.min_time_state2_s
+            and segment_done
+            and sum(m.foot_fz_N) > cfg.feet_force_2to3_N
+            and m.com_W[0] >= m.heel_x + cfg.com_ahead_of_heels_m
+        )
+    elif mode.state == 3:
+        go = (
+            dwell >= cfg.min_time_state3_s
+            and segment_done
+            and min(m.foot_fz_N) > cfg.foot_force_3to4_N
+        )
+    else:
+        go = False
+    if not go:
+        return mode
+    return _enter(mode, mode.state + 1, m, cfg)
+
+
+def _enter(mode: StandupMode, state: int, m: Measurements, cfg: StandupConfig) -> StandupMode:
+    # State 1 holds its start, so its "end" is x_start; later segments have
+    # finished (segment_done), so they end at x_start + delta exactly.
+    x_start = mode.segment_end()
+    if state == 2:
+        delta = np.array(cfg.state2_com_delta_m)
+    elif state == 3:
+        delta = np.array(cfg.state3_com_delta_m)
+    else:
+        delta = np.array([0.0, 0.0, cfg.standing_com_height_m - x_start[2]])
+    entry = list(mode.entry_times_s)
+    entry[state - 1] = m.t
+    return dataclasses.replace(
+        mode,
+        state=state,
+        entry_times_s=tuple(entry),
+        psi_entry=m.psi,
+        segment_psi=cfg.segment_psi[state - 2],
+        x_start_m=tuple(float(v) for v in x_start),
+        delta_m=tuple(float(v) for v in delta),
+    )
+
+
+def seat_scale(mode: StandupMode, t: float, cfg: StandupConfig) -> float:
+    """1 while seated; from state 3 it ramps to 0 over seat_release_s."""
+    if mode.state < 3:
+        return 1.0
+    if cfg.seat_release_s <= 0:
+        return 0.0
+    return max(0.0, 1.0 - (t - mode.entry_times_s[2]) / cfg.seat_release_s)
+
+
+class StandupStateMachine(LeafSystem):
+    """Periodic (update_period_s) state machine with the mode as abstract state.
+
+    Inputs: psi (1), com_W (3), heel_x_W (1), pad_forces_W (3 per pad, rows of
+    the soles given as sole_rows = (left, right)), hand_wrenches_W (12).
+    Outputs: standup_state (1), segment (8: [psi_entry, T, x_start, delta]),
+    contact_plan (3: [state, seat_scale, feet_scale]), entry_times_s (4, NaN
+    for states not reached).
+    """
+
+    def __init__(self, config: StandupConfig, n_pads: int, sole_rows: tuple[int, int]):
+        super().__init__()
+        self._cfg = config
+        self._sole_rows = sole_rows
+        self._mode_index = self.DeclareAbstractState(Value[object](StandupMode()))
+        self._psi = self.DeclareVectorInputPort("psi", 1)
+        self._com = self.DeclareVectorInputPort("com_W", 3)
+        self._heel = self.DeclareVectorInputPort("heel_x_W", 1)
+        self._pads = self.DeclareVectorInputPort("pad_forces_W", 3 * n_pads)
+        self._hands = self.DeclareVectorInputPort("hand_wrenches_W", 12)
+        self.DeclareInitializationUnrestrictedUpdateEvent(self._Initialize)
+        self.DeclarePeriodicUnrestrictedUpdateEvent(
+            config.update_period_s, 0.0, self._Update
+        )
+        mode_only = {self.abstract_state_ticket(self._mode_index)}
+        self.DeclareVectorOutputPort(
+            "standup_state", 1, self._CalcState, prerequisites_of_calc=mode_only
+        )
+        self.DeclareVectorOutputPort(
+            "segment", SEGMENT_SIZE, self._CalcSegment, prerequisites_of_calc=mode_only
+        )
+        self.DeclareVectorOutputPort(
+            "contact_plan",
+            3,
+            self._CalcContactPlan,
+            prerequisites_of_calc={self.abstract_state_ticket(self._mode_index), self.time_ticket()},
+        )
+        self.DeclareVectorOutputPort(
+            "entry_times_s", N_STATES, self._CalcEntryTimes, prerequisites_of_calc=mode_only
+        )
+
+    def mode(self, context: Context) -> StandupMode:
+        return context.get_abstract_state(self._mode_index).get_value()
+
+    def _Initialize(self, context: Context, state: State) -> None:
+        mode = initial_mode(self._com.Eval(context))
+        mode = dataclasses.replace(
+            mode, entry_times_s=(context.get_time(),) + (math.nan,) * (N_STATES - 1)
+        )
+        state.get_mutable_abstract_state(self._mode_index).set_value(mode)
+
+    def _measure(self, context: Context) -> Measurements:
+        pads = self._pads.Eval(context).reshape(-1, 3)
+        hands = self._hands.Eval(context).reshape(2, 6)
+        left, right = self._sole_rows
+        return Measurements(
+            t=context.get_time(),
+            psi=float(self._psi.Eval(context)[0]),
+            com_W=self._com.Eval(context),
+            heel_x=float(self._heel.Eval(context)[0]),
+            foot_fz_N=(float(pads[left, 2]), float(pads[right, 2])),
+            hand_fx_N=(float(hands[0, 3]), float(hands[1, 3])),
+        )
+
+    def _Update(self, context: Context, state: State) -> None:
+        mode = self.mode(context)
+        new = next_mode(mode, self._measure(context), self._cfg)
+        if new is not mode:
+            state.get_mutable_abstract_state(self._mode_index).set_value(new)
+
+    def _CalcState(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self.mode(context).state)
+
+    def _CalcSegment(self, context: Context, output: BasicVector) -> None:
+        output.SetFromVector(self.mode(context).segment())
+
+    def _CalcContactPlan(self, context: Context, output: BasicVector) -> None:
+        mode = self.mode(context)
+        output.SetFromVector([mode.state, seat_scale(mode, context.get_time(), self._cfg), 1.0])
+
+    def _CalcEntryTimes(self, context: Context, output: BasicVector) -> None:
+        output.SetFromVector(np.array(self.mode(context).entry_times_s))

@@ -1,0 +1,125 @@
+"""Scenario loading and validation (drake_standup.config, run_diagram.py).
+
+Each bad scenario is written here, so the key it breaks is known; the error
+must be a ScenarioError whose message is one line naming that key path.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import icub_models
+import pytest
+
+from drake_standup.config import Scenario, ScenarioError, load_scenario
+
+REPO = Path(__file__).resolve().parent.parent
+SEATED = REPO / "scenarios" / "seated.yaml"
+
+
+def test_load_seated_scenario():
+    """scenarios/seated.yaml vs the values it spells out, with defaults for the rest."""
+    scenario = load_scenario(SEATED)
+    assert isinstance(scenario, Scenario)
+    assert scenario.robot.model == "iCubGazeboV2_5"
+    assert scenario.duration_s == 5.0
+    assert scenario.plant.time_step == Scenario().plant.time_step
+
+
+def test_yaml_overrides_defaults(tmp_path):
+    """Values from a written file vs what was written (nested and top level)."""
+    path = tmp_path / "ok.yaml"
+    path.write_text("duration_s: 2.5\nrobot:\n  reduced: false\n  effort_limit_Nm: 40\n")
+    scenario = load_scenario(path)
+    assert scenario.duration_s == 2.5
+    assert scenario.robot.reduced is False
+    assert scenario.robot.effort_limit_Nm == 40.0
+    assert scenario.robot.model == Scenario().robot.model
+
+
+# Bad YAML -> text that the one-line message must contain (the key path).
+BAD = {
+    "unknown_top_level_key": ("duration_s: 1.0\nfoo: 1\n", "foo"),
+    "unknown_nested_key": ("robot:\n  foo: 1\n", "robot.foo"),
+    "wrong_type": ('duration_s: "abc"\n', "duration_s"),
+    "negative": ("duration_s: -1.0\n", "duration_s"),
+    "zero": ("duration_s: 0\n", "duration_s"),
+    "nan": ("duration_s: .nan\n", "duration_s"),
+    "nested_inf": ("initial:\n  base_xyz_m: [0.0, .inf, 0.4]\n", "initial.base_xyz_m[1]"),
+    "unknown_model": ("robot:\n  model: NoSuchRobot\n", "robot.model"),
+    "nan_in_drake_config": ("plant:\n  time_step: .nan\n", "plant.time_step"),
+}
+@pytest.mark.parametrize(("text", "key"), list(BAD.values()), ids=list(BAD))
+def test_bad_scenario_raises_one_line_error_naming_key(tmp_path, text, key):
+    """ScenarioError message vs the key path broken in the written YAML."""
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    message = str(info.value)
+    assert "\n" not in message
+    assert key in message
+
+
+def test_unknown_model_lists_accepted_names(tmp_path):
+    """The robot.model error vs icub_models.get_robot_names(): every name is listed."""
+    path = tmp_path / "bad.yaml"
+    path.write_text("robot:\n  model: NoSuchRobot\n")
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    for name in icub_models.get_robot_names():
+        assert name in str(info.value)
+
+
+def test_missing_file(tmp_path):
+    """A missing scenario file: one-line ScenarioError naming the path."""
+    path = tmp_path / "nonexistent.yaml"
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    message = str(info.value)
+    assert "\n" not in message
+    assert str(path) in message
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["--duration", "-1"],
+        ["--scenario", "/nonexistent.yaml"],
+        ["--duration", "nan"],
+        ["--duration", "abc"],
+    ],
+    ids=["negative_duration", "missing_scenario", "nan_duration", "non_numeric_duration"],
+)
+def test_cli_rejects_bad_input(args):
+    """run_diagram.py exit code and stderr vs the CLI contract: 2, one 'error:' line."""
+    proc = subprocess.run(
+        [sys.executable, "run_diagram.py", *args],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith("error:")
+    assert proc.stdout == ""
+
+
+def test_cli_rejects_wrongly_typed_scenario(tmp_path):
+    """run_diagram.py on duration_s: "abc" vs the CLI contract: exit 2, one 'error:' line."""
+    path = tmp_path / "bad.yaml"
+    path.write_text('duration_s: "abc"\n')
+    proc = subprocess.run(
+        [sys.executable, "run_diagram.py", "--scenario", str(path)],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 2, proc.stderr
+    assert len(proc.stderr.splitlines()) == 1, proc.stderr
+    assert proc.stderr.startswith("error:")
