@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """Simulate the iCub stand-up scenario and write recording, metrics and diagram.
 
-    python run_diagram.py [--scenario PATH] [--out DIR] [--duration S]
+python run_diagram.py [--scenario PATH] [--out DIR] [--duration S]
 """
 
 from __future__ import annotations
@@ -24,10 +24,24 @@ def main(argv: list[str] | None = None) -> int:
     parser = _OneLineErrorParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    parser.add_argument("--scenario", type=Path, default=None, help="scenario YAML (default: scenarios/seated.yaml)")
-    parser.add_argument("--out", type=Path, default=Path("out"), help="output directory (default: out/)")
-    parser.add_argument("--duration", type=float, default=None, help="simulated seconds (overrides the scenario's duration_s)")
-    parser.add_argument("--no-recording", action="store_true", help="skip Meshcat and recording.html (faster)")
+    parser.add_argument(
+        "--scenario",
+        type=Path,
+        default=None,
+        help="scenario YAML (default: scenarios/assisted.yaml)",
+    )
+    parser.add_argument(
+        "--out", type=Path, default=Path("out"), help="output directory (default: out/)"
+    )
+    parser.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        help="simulated seconds (overrides the scenario's duration_s)",
+    )
+    parser.add_argument(
+        "--no-recording", action="store_true", help="skip Meshcat and recording.html (faster)"
+    )
     args = parser.parse_args(argv)
 
     from drake_standup.config import DEFAULT_SCENARIO, ScenarioError, load_scenario, validate
@@ -36,7 +50,9 @@ def main(argv: list[str] | None = None) -> int:
         scenario = load_scenario(args.scenario or DEFAULT_SCENARIO)
         if args.duration is not None:
             if not math.isfinite(args.duration) or args.duration <= 0:
-                raise ScenarioError(f"--duration: {args.duration}; accepted: a number of seconds > 0")
+                raise ScenarioError(
+                    f"--duration: {args.duration}; accepted: a number of seconds > 0"
+                )
             scenario.duration_s = args.duration
             validate(scenario)
     except ScenarioError as err:

@@ -90,9 +90,7 @@ class TrajectoryAdvancement(LeafSystem):
 
     def DoCalcTimeDerivatives(self, context: Context, derivatives: ContinuousState) -> None:
         psi_dot, _ = self._law(context)
-        derivatives.get_mutable_vector().SetFromVector(
-            [psi_dot, self._psi_ddot(context, psi_dot)]
-        )
+        derivatives.get_mutable_vector().SetFromVector([psi_dot, self._psi_ddot(context, psi_dot)])
 
     def _CalcPsi(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, context.get_continuous_state_vector().GetAtIndex(0))

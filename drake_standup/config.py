@@ -6,21 +6,19 @@ silently ignored typo. Defaults live here and nowhere else; the YAML files in
 scenarios/ override what they name.
 """
 
-
 import math
 import typing
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
-
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 SCENARIO_DIR = REPO_ROOT / "scenarios"
-DEFAULT_SCENARIO = SCENARIO_DIR / "seated.yaml"
+DEFAULT_SCENARIO = SCENARIO_DIR / "assisted.yaml"
 
 
 class ScenarioError(ValueError):
@@ -266,9 +264,9 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
     """Loads and validates a scenario file; raises ScenarioError (one line)."""
     path = Path(path) if path is not None else DEFAULT_SCENARIO
     if not path.is_file():
+        shipped = sorted(str(p.relative_to(REPO_ROOT)) for p in SCENARIO_DIR.glob("*.yaml"))
         raise ScenarioError(
-            f"scenario: file '{path}' not found; accepted: a YAML file, e.g. "
-            f"{', '.join(str(p.relative_to(REPO_ROOT)) for p in sorted(SCENARIO_DIR.glob('*.yaml')))}"
+            f"scenario: file '{path}' not found; accepted: a YAML file, e.g. {', '.join(shipped)}"
         )
     try:
         raw = yaml.safe_load(path.read_text())
@@ -319,8 +317,7 @@ def _check_schema(path: str, value, schema) -> None:
         for key, item in value.items():
             if key not in fields:
                 raise ScenarioError(
-                    f"{path + '.' if path else ''}{key}: unknown key; "
-                    f"accepted: {', '.join(fields)}"
+                    f"{path + '.' if path else ''}{key}: unknown key; accepted: {', '.join(fields)}"
                 )
             _check_schema(f"{path + '.' if path else ''}{key}", item, fields[key])
         return

@@ -9,9 +9,7 @@ from pydrake.multibody.plant import ContactResults
 from pydrake.systems.framework import Context, LeafSystem
 
 
-def pad_forces(
-    results: ContactResults, pad_ids: dict[GeometryId, int], n_pads: int
-) -> np.ndarray:
+def pad_forces(results: ContactResults, pad_ids: dict[GeometryId, int], n_pads: int) -> np.ndarray:
     """Net world-frame force on each pad (rows in pad order), N.
 
     Hydroelastic: F_Ac_W acts on the body of geometry M. Point contact
@@ -48,12 +46,8 @@ class ContactForceReporter(LeafSystem):
         super().__init__()
         self.pad_names = list(pad_names)
         self._rows = {gid: i for i, gid in enumerate(pad_ids)}
-        self._results = self.DeclareAbstractInputPort(
-            "contact_results", Value(ContactResults())
-        )
-        self.DeclareVectorOutputPort(
-            "pad_forces_W", 3 * len(self.pad_names), self._CalcForces
-        )
+        self._results = self.DeclareAbstractInputPort("contact_results", Value(ContactResults()))
+        self.DeclareVectorOutputPort("pad_forces_W", 3 * len(self.pad_names), self._CalcForces)
 
     def _CalcForces(self, context: Context, output) -> None:
         results = self._results.Eval(context)

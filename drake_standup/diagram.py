@@ -28,6 +28,7 @@ class StandupDiagram:
     scene: Scene
     pad_groups: dict[str, str]  # pad geometry name -> group, in reporter order
     state_machine: StandupStateMachine
+    advancement: TrajectoryAdvancement
     logs: dict[str, VectorLogSink]  # signal name -> logger
     visualizer: MeshcatVisualizer | None
 
@@ -77,15 +78,9 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
     builder.Connect(plant.get_contact_results_output_port(), reporter.get_input_port())
 
     robot = scene.robot
-    human = builder.AddNamedSystem(
-        "human", HumanWrenchSource(plant, robot, scenario.human)
-    )
-    sensing = builder.AddNamedSystem(
-        "sensing", RobotSensing(plant, robot, heel_points(robot))
-    )
-    advancement = builder.AddNamedSystem(
-        "advancement", TrajectoryAdvancement(scenario.advancement)
-    )
+    human = builder.AddNamedSystem("human", HumanWrenchSource(plant, robot, scenario.human))
+    sensing = builder.AddNamedSystem("sensing", RobotSensing(plant, robot, heel_points(robot)))
+    advancement = builder.AddNamedSystem("advancement", TrajectoryAdvancement(scenario.advancement))
     reference = builder.AddNamedSystem("com_reference", CoMReferenceGenerator())
     sole_rows = tuple(
         pad_names.index(s.name)
@@ -99,13 +94,17 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
 
     robot_state = plant.get_state_output_port(instance)
     hand_wrenches = human.GetOutputPort("hand_wrenches_W")
-    builder.Connect(human.GetOutputPort("spatial_forces"), plant.get_applied_spatial_force_input_port())
+    builder.Connect(
+        human.GetOutputPort("spatial_forces"), plant.get_applied_spatial_force_input_port()
+    )
     builder.Connect(robot_state, human.GetInputPort("robot_state"))
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
     builder.Connect(hand_wrenches, sensing.GetInputPort("hand_wrenches_W"))
     for name in ("com_velocity_W", "omega_f_W"):
         builder.Connect(sensing.GetOutputPort(name), advancement.GetInputPort(name))
-    builder.Connect(reference.GetOutputPort("path_tangent_W"), advancement.GetInputPort("path_tangent_W"))
+    builder.Connect(
+        reference.GetOutputPort("path_tangent_W"), advancement.GetInputPort("path_tangent_W")
+    )
     for name in ("psi", "psi_dot", "psi_ddot"):
         builder.Connect(advancement.GetOutputPort(name), reference.GetInputPort(name))
     builder.Connect(state_machine.GetOutputPort("segment"), reference.GetInputPort("segment"))
@@ -152,7 +151,7 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
 
     diagram = builder.Build()
     diagram.set_name("standup")
-    return StandupDiagram(diagram, scene, pad_groups, state_machine, logs, visualizer)
+    return StandupDiagram(diagram, scene, pad_groups, state_machine, advancement, logs, visualizer)
 
 
 class _AllJoints(dict):

@@ -76,9 +76,7 @@ class HumanWrenchSource(LeafSystem):
         self._context = plant.CreateDefaultContext()
         self._frames = [robot.frame(plant, name) for name in TASK_FRAMES]
         self._bodies = [frame.body() for frame in self._frames]
-        self._p_BoFo_B = [
-            frame.GetFixedPoseInBodyFrame().translation() for frame in self._frames
-        ]
+        self._p_BoFo_B = [frame.GetFixedPoseInBodyFrame().translation() for frame in self._frames]
         nx = plant.num_multibody_states(self._instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         prereq = {self.time_ticket()}

@@ -37,9 +37,7 @@ def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
     data = Path(path).read_bytes()
     n_tri = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
     if n_tri >= 0 and len(data) == 84 + 50 * n_tri:
-        record = np.dtype(
-            [("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attr", "<u2")]
-        )
+        record = np.dtype([("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attr", "<u2")])
         corners = np.frombuffer(data, dtype=record, count=n_tri, offset=84)["corners"]
     else:
         words = data.decode("ascii", errors="replace").split()
@@ -53,9 +51,7 @@ def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
     vertices, inverse = np.unique(corners, axis=0, return_inverse=True)
     faces = inverse.reshape(-1, 3)
     keep = (
-        (faces[:, 0] != faces[:, 1])
-        & (faces[:, 1] != faces[:, 2])
-        & (faces[:, 0] != faces[:, 2])
+        (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
     )
     return vertices, faces[keep]
 

@@ -94,13 +94,13 @@ def seated_metrics(
 
 
 def advancement_metrics(
-    psi: np.ndarray, psi_dot: np.ndarray, entry_times_s: tuple[float, ...]
+    psi_final: float, psi_dot: np.ndarray, entry_times_s: tuple[float, ...]
 ) -> dict:
     """psi at the end, the range of psi_dot, when each state was entered."""
-    if len(psi) == 0:
-        return {}
+    if len(psi_dot) == 0:
+        return {"psi_final": float(psi_final)}
     return {
-        "psi_final": float(psi[-1]),
+        "psi_final": float(psi_final),
         "psi_dot_min": float(np.min(psi_dot)),
         "psi_dot_max": float(np.max(psi_dot)),
         "state_entry_times_s": [None if np.isnan(t) else float(t) for t in entry_times_s],

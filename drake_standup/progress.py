@@ -30,9 +30,8 @@ class ProgressBar:
             self.stream.flush()
         elif int(10 * frac) > self._last_decile:
             self._last_decile = int(10 * frac)
-            self.stream.write(
-                f"{self.label}: {100 * frac:3.0f}% ({done:.2f}/{self.total:.2f} {self.unit}) {note}\n"
-            )
+            counts = f"({done:.2f}/{self.total:.2f} {self.unit})"
+            self.stream.write(f"{self.label}: {100 * frac:3.0f}% {counts} {note}\n")
             self.stream.flush()
 
     def close(self) -> None:

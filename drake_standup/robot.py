@@ -13,7 +13,6 @@ What this module does to the published URDF, in order:
   4. Adds a JointActuator per revolute joint with the scenario's effort limit.
 """
 
-
 import hashlib
 import os
 import xml.etree.ElementTree as ET
@@ -33,8 +32,8 @@ from pydrake.geometry import (
     Sphere,
 )
 from pydrake.math import RigidTransform, RollPitchYaw
-from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import (
     FixedOffsetFrame,
     JointActuator,
@@ -66,9 +65,7 @@ def original_urdf(model_name: str) -> Path:
 
     names = robot_names()
     if model_name not in names:
-        raise ModelError(
-            f"robot.model: unknown model '{model_name}'; accepted: {', '.join(names)}"
-        )
+        raise ModelError(f"robot.model: unknown model '{model_name}'; accepted: {', '.join(names)}")
     return Path(icub_models.get_model_file(model_name))
 
 
@@ -157,9 +154,7 @@ def prepare_urdf(
     return PreparedUrdf(out, leaf_frames)
 
 
-def _remove_bare_subtrees(
-    robot: ET.Element, links: dict[str, ET.Element]
-) -> list[LeafFrame]:
+def _remove_bare_subtrees(robot: ET.Element, links: dict[str, ET.Element]) -> list[LeafFrame]:
     """Removes every subtree of bare links on fixed joints; returns their frames."""
     joints = robot.findall("joint")
     children: dict[str, list[ET.Element]] = {name: [] for name in links}
@@ -253,9 +248,7 @@ def _shape(spec: ContactShape):
             f"accepted: {', '.join(expected)}"
         )
     if len(s) != expected[spec.shape]:
-        raise ModelError(
-            f"contact shape '{spec.name}': size_m needs {expected[spec.shape]} values"
-        )
+        raise ModelError(f"contact shape '{spec.name}': size_m needs {expected[spec.shape]} values")
     if spec.shape == "box":
         return Box(*s)
     if spec.shape == "capsule":

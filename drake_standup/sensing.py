@@ -46,9 +46,7 @@ class RobotSensing(LeafSystem):
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         self._wrenches = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         state_only = {self._state.ticket()}
-        self.DeclareVectorOutputPort(
-            "com_W", 3, self._CalcCom, prerequisites_of_calc=state_only
-        )
+        self.DeclareVectorOutputPort("com_W", 3, self._CalcCom, prerequisites_of_calc=state_only)
         self.DeclareVectorOutputPort(
             "com_velocity_W", 3, self._CalcComVelocity, prerequisites_of_calc=state_only
         )

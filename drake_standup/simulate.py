@@ -175,9 +175,12 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
     )
     metrics["robot_mass_kg"] = mass_kg
     sm_context = built.state_machine.GetMyContextFromRoot(root_context)
+    psi_now = built.advancement.GetOutputPort("psi").Eval(
+        built.advancement.GetMyContextFromRoot(root_context)
+    )[0]
     metrics.update(
         outputs.advancement_metrics(
-            _log(built, root_context, "psi").data()[0],
+            psi_now,
             _log(built, root_context, "psi_dot").data()[0],
             built.state_machine.mode(sm_context).entry_times_s,
         )

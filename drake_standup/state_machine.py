@@ -146,9 +146,7 @@ class StandupStateMachine(LeafSystem):
         self._pads = self.DeclareVectorInputPort("pad_forces_W", 3 * n_pads)
         self._hands = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         self.DeclareInitializationUnrestrictedUpdateEvent(self._Initialize)
-        self.DeclarePeriodicUnrestrictedUpdateEvent(
-            config.update_period_s, 0.0, self._Update
-        )
+        self.DeclarePeriodicUnrestrictedUpdateEvent(config.update_period_s, 0.0, self._Update)
         mode_only = {self.abstract_state_ticket(self._mode_index)}
         self.DeclareVectorOutputPort(
             "standup_state", 1, self._CalcState, prerequisites_of_calc=mode_only
@@ -160,7 +158,10 @@ class StandupStateMachine(LeafSystem):
             "contact_plan",
             3,
             self._CalcContactPlan,
-            prerequisites_of_calc={self.abstract_state_ticket(self._mode_index), self.time_ticket()},
+            prerequisites_of_calc={
+                self.abstract_state_ticket(self._mode_index),
+                self.time_ticket(),
+            },
         )
         self.DeclareVectorOutputPort(
             "entry_times_s", N_STATES, self._CalcEntryTimes, prerequisites_of_calc=mode_only

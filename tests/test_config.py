@@ -51,6 +51,8 @@ BAD = {
     "unknown_model": ("robot:\n  model: NoSuchRobot\n", "robot.model"),
     "nan_in_drake_config": ("plant:\n  time_step: .nan\n", "plant.time_step"),
 }
+
+
 @pytest.mark.parametrize(("text", "key"), list(BAD.values()), ids=list(BAD))
 def test_bad_scenario_raises_one_line_error_naming_key(tmp_path, text, key):
     """ScenarioError message vs the key path broken in the written YAML."""

@@ -72,3 +72,26 @@ def test_only_the_pads_touch_anything(seated_run):
         "buttocks_pad",
     }
     assert np.all(final > 1.0)
+
+
+def test_psi_equals_time_without_a_pull(seated_run):
+    """Nobody pulls: psi(t) = t to 1e-9 over the whole run, psi_dot = 1."""
+    _, result, _ = seated_run
+    assert result.metrics["psi_final"] == pytest.approx(5.0, abs=1e-9)
+    assert result.metrics["psi_dot_min"] == 1.0 and result.metrics["psi_dot_max"] == 1.0
+    assert result.metrics["state_entry_times_s"] == [0.0, None, None, None]
+
+
+def test_psi_equals_time_with_advancement_disabled():
+    """A pull from t = 0.5 s, advancement off: psi = t, psi_dot = 1 exactly."""
+    from drake_standup.config import SCENARIO_DIR, load_scenario
+    from drake_standup.simulate import simulate
+
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
+    scenario.advancement.enabled = False
+    scenario.duration_s = 1.5
+    for pull in scenario.human.pulls:
+        pull.start_s = 0.5
+    result = simulate(scenario, None, record=False, progress=False)
+    assert result.metrics["psi_final"] == pytest.approx(1.5, abs=1e-9)
+    assert result.metrics["psi_dot_min"] == 1.0 and result.metrics["psi_dot_max"] == 1.0

@@ -1,0 +1,139 @@
+"""Trajectory advancement: the update law, psi as continuous state, Omega f."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.analysis import Simulator
+
+from drake_standup.advancement import TrajectoryAdvancement, psi_dot_law
+from drake_standup.config import AdvancementConfig
+from drake_standup.robot import ContactModel, add_icub
+from drake_standup.sensing import RobotSensing
+
+CFG = AdvancementConfig()
+TANGENT = np.array([0.12, 0.0, 0.02])  # a state-2-like path tangent, m per unit psi
+
+
+def _cfg(**kw) -> AdvancementConfig:
+    return dataclasses.replace(CFG, **kw)
+
+
+@pytest.mark.parametrize("law", ["tangent", "interaction"])
+def test_no_pull_gives_psi_dot_one_whatever_the_motion(law):
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        v = rng.normal(scale=0.5, size=3)
+        t = rng.normal(scale=0.2, size=3)
+        assert psi_dot_law(_cfg(law=law), v, np.zeros(3), t)[0] == 1.0
+
+
+@pytest.mark.parametrize("law", ["tangent", "interaction"])
+def test_disabled_gives_psi_dot_one_even_when_helped(law):
+    omega_f = TANGENT / np.linalg.norm(TANGENT)  # 1 m/s^2 along the path
+    v = 2.0 * TANGENT
+    assert psi_dot_law(_cfg(law=law, enabled=False), v, omega_f, TANGENT)[0] == 1.0
+    assert psi_dot_law(_cfg(law=law), v, omega_f, TANGENT)[0] > 1.0
+
+
+@pytest.mark.parametrize("law", ["tangent", "interaction"])
+def test_psi_dot_stays_within_bounds_under_any_input(law):
+    """Random velocities, tangents and wrenches (helpful, hindering, lateral,
+    huge): psi_dot is always in [1, psi_dot_upper]."""
+    rng = np.random.default_rng(1)
+    cfg = _cfg(law=law, psi_dot_upper=2.5)
+    seen_upper = seen_one = False
+    for _ in range(5000):
+        scale = 10.0 ** rng.uniform(-3, 2)
+        v, t, f = (rng.normal(scale=scale, size=3) for _ in range(3))
+        psi_dot, _ = psi_dot_law(cfg, v, f, t)
+        assert 1.0 <= psi_dot <= 2.5
+        seen_upper |= psi_dot == 2.5
+        seen_one |= psi_dot == 1.0
+    assert seen_upper and seen_one  # both bounds are actually reached
+
+
+@pytest.mark.parametrize("law", ["tangent", "interaction"])
+def test_hindering_and_perpendicular_pulls_do_not_advance(law):
+    direction = TANGENT / np.linalg.norm(TANGENT)
+    lateral = np.array([0.0, 1.0, 0.0])
+    v_fast = 2.0 * TANGENT  # CoM moving along the path faster than psi = t
+    assert psi_dot_law(_cfg(law=law), v_fast, -0.9 * direction, TANGENT)[0] == 1.0
+    assert psi_dot_law(_cfg(law=law), v_fast, 0.9 * lateral, TANGENT)[0] == 1.0
+
+
+def test_tangent_law_value_matches_the_proposition():
+    """Helpful pull, CoM faster than the reference: the paper's ratio exactly."""
+    v = 1.8 * TANGENT + np.array([0.0, 0.01, 0.0])
+    omega_f = 0.9 * TANGENT / np.linalg.norm(TANGENT)
+    expected = (v @ TANGENT) / (TANGENT @ TANGENT + CFG.eps)
+    psi_dot, alpha = psi_dot_law(CFG, v, omega_f, TANGENT)
+    assert psi_dot == pytest.approx(expected, rel=1e-12)
+    assert 1.7 < psi_dot < 1.8
+    assert alpha == pytest.approx(0.9)
+
+
+def test_interaction_law_value_matches_the_authors_ratio():
+    v = 1.5 * TANGENT
+    omega_f = np.array([0.6, 0.0, 0.5])
+    a = TANGENT @ omega_f
+    expected = (v @ omega_f) * a / (a * a + CFG.eps)
+    assert psi_dot_law(_cfg(law="interaction"), v, omega_f, TANGENT)[0] == pytest.approx(
+        expected, rel=1e-12
+    )
+
+
+def _simulate_advancement(cfg, v, omega_f, tangent, t_end):
+    system = TrajectoryAdvancement(cfg)
+    context = system.CreateDefaultContext()
+    system.GetInputPort("com_velocity_W").FixValue(context, v)
+    system.GetInputPort("omega_f_W").FixValue(context, omega_f)
+    system.GetInputPort("path_tangent_W").FixValue(context, tangent)
+    simulator = Simulator(system, context)
+    simulator.AdvanceTo(t_end)
+    return system, context
+
+
+def test_psi_equals_time_without_help():
+    system, context = _simulate_advancement(CFG, 2.0 * TANGENT, np.zeros(3), TANGENT, 7.3)
+    assert system.GetOutputPort("psi").Eval(context)[0] == pytest.approx(7.3, abs=1e-9)
+    assert system.GetOutputPort("psi_dot").Eval(context)[0] == 1.0
+    assert system.GetOutputPort("psi_ddot").Eval(context)[0] == 0.0
+
+
+def test_psi_integrates_the_law():
+    """Constant helpful inputs: psi(T) = ratio * T, the analytic integral."""
+    v = 1.6 * TANGENT
+    omega_f = TANGENT / np.linalg.norm(TANGENT)
+    ratio = (v @ TANGENT) / (TANGENT @ TANGENT + CFG.eps)
+    system, context = _simulate_advancement(CFG, v, omega_f, TANGENT, 2.0)
+    assert system.GetOutputPort("psi").Eval(context)[0] == pytest.approx(2.0 * ratio, rel=1e-9)
+    # psi_ddot is the derivative of the low-passed psi_dot: decayed after 40 tau.
+    assert abs(system.GetOutputPort("psi_ddot").Eval(context)[0]) < 1e-6
+
+
+def test_omega_f_is_total_hand_force_over_mass():
+    """Omega f = J_com M^-1 sum J_h^T F_h must equal sum F/m: the linear
+    momentum theorem, whatever the configuration and wherever the force acts
+    (hand torques do not move the CoM)."""
+    plant = MultibodyPlant(0.0)
+    robot = add_icub(plant, visuals=False, contact=ContactModel())
+    plant.Finalize()
+    sensing = RobotSensing(plant, robot, {})
+    context = sensing.CreateDefaultContext()
+    mass = plant.CalcTotalMass(plant.CreateDefaultContext())
+    rng = np.random.default_rng(3)
+    nq = plant.num_positions()
+    for _ in range(5):
+        q = np.concatenate([rng.normal(size=4), rng.normal(size=3), rng.uniform(-1, 1, nq - 7)])
+        q[:4] /= np.linalg.norm(q[:4])
+        x = np.concatenate([q, rng.normal(size=plant.num_velocities())])
+        wrenches = rng.normal(scale=10.0, size=12)
+        sensing.GetInputPort("robot_state").FixValue(context, x)
+        sensing.GetInputPort("hand_wrenches_W").FixValue(context, wrenches)
+        omega_f = sensing.GetOutputPort("omega_f_W").Eval(context)
+        expected = (wrenches[3:6] + wrenches[9:12]) / mass
+        np.testing.assert_allclose(omega_f, expected, rtol=1e-8, atol=1e-10)
