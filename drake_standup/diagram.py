@@ -124,6 +124,8 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
         "alpha": advancement.GetOutputPort("alpha"),
         "com_reference": reference.GetOutputPort("com_reference"),
         "standup_state": state_machine.GetOutputPort("standup_state"),
+        "segment": state_machine.GetOutputPort("segment"),
+        "net_actuation": plant.get_net_actuation_output_port(instance),
     }
     logs = {}
     for name, port in logged.items():

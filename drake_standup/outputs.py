@@ -105,3 +105,140 @@ def advancement_metrics(
         "psi_dot_max": float(np.max(psi_dot)),
         "state_entry_times_s": [None if np.isnan(t) else float(t) for t in entry_times_s],
     }
+
+
+# --- Figures -----------------------------------------------------------------
+
+STATE_COLORS = {2: "tab:orange", 3: "tab:green", 4: "tab:purple"}
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _mark_states(ax, entry_times_s, label: bool = False) -> None:
+    for k, t in enumerate(entry_times_s[1:], start=2):
+        if t is not None and np.isfinite(t):
+            ax.axvline(t, color=STATE_COLORS[k], ls=":", lw=1.2, label=f"state {k}" if label else None)
+
+
+def figure_advancement(signals: dict, baseline: dict | None, entry_times_s, path: Path) -> None:
+    """The paper's Fig. 3: hand wrench, psi_dot, psi, and the CoM reference
+    (with the same run's reference without advancement, faded)."""
+    plt = _plt()
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+    (ax_f, ax_dpsi), (ax_psi, ax_ref) = axes
+
+    t, w = signals["hand_wrenches_W"]
+    for hand, row, ls in (("left", 0, "-"), ("right", 6, "--")):
+        for axis, color in ((0, "tab:red"), (2, "tab:blue")):
+            name = "xyz"[axis]
+            ax_f.plot(t, w[row + 3 + axis], ls, color=color, label=f"{hand} f_{name}")
+    ax_f.set_ylabel("hand force [N]")
+    ax_f.set_title("(a) interaction wrench at the hands")
+    ax_f.legend(fontsize=8, ncol=2)
+
+    t, psi_dot = signals["psi_dot"]
+    ax_dpsi.plot(t, psi_dot[0], color="tab:green")
+    ax_dpsi.axhline(1.0, color="gray", lw=0.8)
+    ax_dpsi.set_ylabel("psi_dot [-]")
+    ax_dpsi.set_title("(b) rate of the free parameter")
+
+    t, psi = signals["psi"]
+    ax_psi.plot(t, psi[0], color="tab:green", label="psi")
+    ax_psi.plot(t, t, color="gray", lw=0.8, ls="--", label="psi = t")
+    ax_psi.set_ylabel("psi [-]")
+    ax_psi.set_title("(c) free parameter")
+    ax_psi.legend(fontsize=8)
+
+    t, ref = signals["com_reference"]
+    for axis, color in ((0, "tab:red"), (2, "tab:blue")):
+        name = "xyz"[axis]
+        ax_ref.plot(t, ref[axis], color=color, label=f"x_d,{name} with advancement")
+        if baseline is not None:
+            tb, refb = baseline["com_reference"]
+            ax_ref.plot(tb, refb[axis], color=color, alpha=0.3, lw=3, label=f"x_d,{name} psi = t")
+    ax_ref.set_ylabel("CoM reference [m]")
+    ax_ref.set_title("(d) CoM reference")
+    ax_ref.legend(fontsize=8)
+    for ax in axes.flat:
+        _mark_states(ax, entry_times_s)
+        ax.grid(alpha=0.3)
+    for ax in axes[1]:
+        ax.set_xlabel("time [s]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def figure_tracking(signals: dict, pad_groups: dict[str, str], entry_times_s, path: Path) -> None:
+    """CoM against its reference, and the contact normal forces, with the
+    state switches marked."""
+    plt = _plt()
+    fig, (ax_x, ax_z, ax_f) = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+    t, com = signals["com_W"]
+    tr, ref = signals["com_reference"]
+    for ax, axis in ((ax_x, 0), (ax_z, 2)):
+        name = "xyz"[axis]
+        ax.plot(tr, ref[axis], color="black", ls="--", label=f"reference x_d,{name}")
+        ax.plot(t, com[axis], color="tab:blue", label=f"CoM {name}")
+        ax.set_ylabel(f"CoM {name} [m]")
+        ax.legend(fontsize=8)
+    t, pads = signals["pad_forces_W"]
+    pads = pads.reshape(len(pad_groups), 3, -1)
+    for group in dict.fromkeys(pad_groups.values()):
+        rows = [i for i, g in enumerate(pad_groups.values()) if g == group]
+        ax_f.plot(t, pads[rows, 2].sum(axis=0), label=group)
+    ax_f.set_ylabel("normal force [N]")
+    ax_f.set_xlabel("time [s]")
+    ax_f.legend(fontsize=8)
+    for ax in (ax_x, ax_z, ax_f):
+        _mark_states(ax, entry_times_s, label=ax is ax_x)
+        ax.grid(alpha=0.3)
+    ax_x.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def standup_metrics(
+    signals: dict,
+    pad_groups: dict[str, str],
+    entry_times_s,
+    *,
+    com_tolerance_m: float = 0.02,
+    unloaded_N: float = 1.0,
+) -> dict:
+    """Stand-up time, CoM tracking and whether the robot is standing at the end.
+
+    Standing at a sample: state 4, the reference at its end (psi past the last
+    segment), the CoM within com_tolerance_m of the reference, and nothing but
+    the soles loaded (every other pad below unloaded_N). standup_time_s runs
+    from entering state 2 to the first standing sample (None if never).
+    """
+    t, com = signals["com_W"]
+    _, ref = signals["com_reference"]
+    _, psi = signals["psi"]
+    _, state = signals["standup_state"]
+    _, segment = signals["segment"]
+    _, pads = signals["pad_forces_W"]
+    pads = pads.reshape(len(pad_groups), 3, -1)
+    error = np.linalg.norm(com - ref[:3], axis=0)
+    others = [i for i, g in enumerate(pad_groups.values()) if g != "soles"]
+    seat_free = np.all(pads[others, 2] < unloaded_N, axis=0)
+    path_done = psi[0] - segment[0] >= segment[1]
+    standing = (state[0] == 4) & path_done & (error <= com_tolerance_m) & seat_free
+    metrics: dict = {
+        "com_tracking_rms_m": float(np.sqrt(np.mean(error**2))) if len(t) else None,
+        "standing_at_end": bool(standing[-1]) if len(t) else False,
+        "standup_time_s": None,
+    }
+    t2 = entry_times_s[1]
+    if standing.any() and t2 is not None and np.isfinite(t2):
+        metrics["standup_time_s"] = float(t[np.argmax(standing)] - t2)
+    return metrics

@@ -27,10 +27,26 @@ GRAVITY_MPS2 = 9.81
 class RunResult:
     metrics: dict
     files: dict[str, Path] = field(default_factory=dict)
-    times_s: np.ndarray | None = None
-    com_W: np.ndarray | None = None  # (3, N) CoM at the log times
-    pad_forces_W: np.ndarray | None = None  # (n_pads, 3, N)
-    pad_names: list[str] = field(default_factory=list)
+    # Logged signal name -> (sample times (N,), data (size, N)).
+    signals: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    pad_groups: dict[str, str] = field(default_factory=dict)  # pad -> group, log order
+
+    @property
+    def times_s(self) -> np.ndarray:
+        return self.signals["com_W"][0]
+
+    @property
+    def com_W(self) -> np.ndarray:
+        return self.signals["com_W"][1]
+
+    @property
+    def pad_forces_W(self) -> np.ndarray:
+        """(n_pads, 3, N) world force on each pad."""
+        return self.signals["pad_forces_W"][1].reshape(len(self.pad_groups), 3, -1)
+
+    @property
+    def pad_names(self) -> list[str]:
+        return list(self.pad_groups)
 
 
 def make_meshcat() -> Meshcat:
@@ -156,33 +172,35 @@ class _FallMonitor:
         return EventStatus.DidNothing()
 
 
-def _log(built: StandupDiagram, root_context, name: str):
-    return built.logs[name].FindLog(root_context)
-
-
 def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResult:
-    """Reads the loggers into arrays and turns them into metrics."""
+    """Reads every logger and turns the signals into metrics."""
     plant = built.scene.plant
     instance = built.scene.robot.model_instance
-    com_log = _log(built, root_context, "com_W")
-    times = com_log.sample_times()
-    com = com_log.data()
-    pad_forces = _log(built, root_context, "pad_forces_W").data()
-    pad_forces = pad_forces.reshape(len(built.pad_groups), 3, -1)
+    signals = {}
+    for name, logger in built.logs.items():
+        log = logger.FindLog(root_context)
+        signals[name] = (log.sample_times().copy(), log.data().copy())
+    result = RunResult({}, signals=signals, pad_groups=dict(built.pad_groups))
     mass_kg = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
     metrics = outputs.seated_metrics(
-        times, com, pad_forces, built.pad_groups, weight_N=mass_kg * GRAVITY_MPS2
+        result.times_s,
+        result.com_W,
+        result.pad_forces_W,
+        built.pad_groups,
+        weight_N=mass_kg * GRAVITY_MPS2,
     )
     metrics["robot_mass_kg"] = mass_kg
-    sm_context = built.state_machine.GetMyContextFromRoot(root_context)
+    entry_times = built.state_machine.mode(
+        built.state_machine.GetMyContextFromRoot(root_context)
+    ).entry_times_s
     psi_now = built.advancement.GetOutputPort("psi").Eval(
         built.advancement.GetMyContextFromRoot(root_context)
     )[0]
+    metrics.update(outputs.advancement_metrics(psi_now, signals["psi_dot"][1][0], entry_times))
     metrics.update(
-        outputs.advancement_metrics(
-            psi_now,
-            _log(built, root_context, "psi_dot").data()[0],
-            built.state_machine.mode(sm_context).entry_times_s,
-        )
+        outputs.standup_metrics(signals, built.pad_groups, metrics["state_entry_times_s"])
     )
-    return RunResult(metrics, {}, times, com, pad_forces, list(built.pad_groups))
+    torques = signals["net_actuation"][1]
+    metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
+    result.metrics = metrics
+    return result
