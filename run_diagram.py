@@ -61,13 +61,20 @@ def main(argv: list[str] | None = None) -> int:
 
     from drake_standup.simulate import simulate
 
-    result = simulate(scenario, args.out, record=not args.no_recording)
+    result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
     m = result.metrics
     for name, path in result.files.items():
         print(f"wrote {name}: {path}")
+    if m.get("standup_time_s") is not None:
+        outcome = f"stood up in {m['standup_time_s']:.2f} s"
+        if m.get("standup_time_s_without_advancement") is not None:
+            outcome += f" ({m['standup_time_s_without_advancement']:.2f} s without advancement)"
+    else:
+        outcome = "did not stand up"
     status = "OK" if m["success"] else f"FAILED ({m['failure_reason']})"
     print(
-        f"{status}: simulated {m['sim_time_s']:.2f} s in {m['wall_time_s']:.1f} s wall "
+        f"{status}: {outcome}; psi_final {m.get('psi_final', float('nan')):.2f}; "
+        f"simulated {m['sim_time_s']:.2f} s in {m['wall_time_s']:.1f} s wall "
         f"({m['realtime_factor']:.2f}x real time)"
     )
     return 0

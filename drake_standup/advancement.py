@@ -11,6 +11,14 @@ The interaction helps when alpha = t.Omega f / |t| (the part of Omega f along
 the desired velocity) exceeds alpha_min; otherwise, and with advancement
 disabled, psi_dot = 1 and psi = t. psi therefore never runs backwards nor
 faster than psi_dot_upper.
+
+Lead gate (ours, on by default): the law also waits until the CoM is not behind
+its reference along the path, lead = (x - x_d).t/|t| >= -lag_tolerance. The
+ratio sets the reference's speed to the CoM's; with a finite-gain tracker,
+advancing while the CoM lags closes a positive loop (x_d ahead -> K_P pushes ->
+the CoM speeds up -> psi runs further ahead), which in our closed loop threw the
+robot forward at the start of state 4. Advancing only on a lead keeps the
+reference where the help has already brought the robot.
 """
 
 from __future__ import annotations
@@ -31,15 +39,24 @@ def helpfulness(tangent: np.ndarray, omega_f: np.ndarray, eps: float) -> float:
     return float(tangent @ omega_f) / math.sqrt(t2)
 
 
+def lead(com: np.ndarray, x_d: np.ndarray, tangent: np.ndarray) -> float:
+    """How far the CoM is ahead of its reference along the path. m."""
+    norm = float(np.linalg.norm(tangent))
+    return float((com - x_d) @ tangent) / norm if norm > 0.0 else 0.0
+
+
 def psi_dot_law(
     config: AdvancementConfig,
     com_velocity: np.ndarray,
     omega_f: np.ndarray,
     tangent: np.ndarray,
+    lead_m: float = 0.0,
 ) -> tuple[float, float]:
-    """(psi_dot, alpha) by the configured update law."""
+    """(psi_dot, alpha) by the configured update law; lead_m feeds the lead gate."""
     alpha = helpfulness(tangent, omega_f, config.eps)
     if not config.enabled or alpha <= config.alpha_min_mps2:
+        return 1.0, alpha
+    if config.lead_gate and lead_m < -config.lag_tolerance_m:
         return 1.0, alpha
     if config.law == "tangent":
         ratio = float(com_velocity @ tangent) / (float(tangent @ tangent) + config.eps)
@@ -50,7 +67,7 @@ def psi_dot_law(
 
 
 class TrajectoryAdvancement(LeafSystem):
-    """Inputs com_velocity_W, omega_f_W, path_tangent_W (3 each).
+    """Inputs com_W, com_velocity_W, omega_f_W, x_d_W, path_tangent_W (3 each).
 
     Continuous state [psi, psi_dot_f]: psi integrates the law; psi_dot_f is
     psi_dot low-passed (time constant psi_ddot_filter_s), whose derivative is
@@ -63,8 +80,10 @@ class TrajectoryAdvancement(LeafSystem):
         super().__init__()
         self._config = config
         self.DeclareContinuousState(BasicVector([0.0, 1.0]))
+        self._com = self.DeclareVectorInputPort("com_W", 3)
         self._v = self.DeclareVectorInputPort("com_velocity_W", 3)
         self._omega_f = self.DeclareVectorInputPort("omega_f_W", 3)
+        self._x_d = self.DeclareVectorInputPort("x_d_W", 3)
         self._tangent = self.DeclareVectorInputPort("path_tangent_W", 3)
         self.DeclareVectorOutputPort(
             "psi",
@@ -77,11 +96,13 @@ class TrajectoryAdvancement(LeafSystem):
         self.DeclareVectorOutputPort("alpha", 1, self._CalcAlpha)
 
     def _law(self, context: Context) -> tuple[float, float]:
+        tangent = self._tangent.Eval(context)
         return psi_dot_law(
             self._config,
             self._v.Eval(context),
             self._omega_f.Eval(context),
-            self._tangent.Eval(context),
+            tangent,
+            lead(self._com.Eval(context), self._x_d.Eval(context), tangent),
         )
 
     def _psi_ddot(self, context: Context, psi_dot: float) -> float:

@@ -16,6 +16,8 @@ from pydrake.common.yaml import yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
+from drake_standup.controller import ControllerConfig
+
 REPO_ROOT = Path(__file__).resolve().parent.parent
 SCENARIO_DIR = REPO_ROOT / "scenarios"
 DEFAULT_SCENARIO = SCENARIO_DIR / "assisted.yaml"
@@ -143,6 +145,11 @@ class AdvancementConfig:
     # alpha (hand-induced CoM acceleration along the path) above which the
     # interaction counts as helpful: ~1.6 N of net pull along the path. m/s^2.
     alpha_min_mps2: float = 0.05
+    # Advance only while the CoM is not behind its reference along the path
+    # (see advancement.py: without it the law and the tracker run away). The
+    # tolerance admits the tracker's steady lag. m.
+    lead_gate: bool = True
+    lag_tolerance_m: float = 0.005
     # Time constant of the psi_dot filter whose derivative feeds xd_ddot. s.
     psi_ddot_filter_s: float = 0.05
 
@@ -172,15 +179,18 @@ class StandupConfig:
     standing_com_height_m: float = 0.526
     # 2 -> 3: feet carry this much together (SPEC 3)... N
     feet_force_2to3_N: float = 150.0
-    # ... after at least this long in state 2 (SPEC 3)... s
-    min_time_state2_s: float = 1.5
+    # ... after at least this long in state 2. The authors' 1.5 s (SPEC 3) equals
+    # the segment's length in psi, which "segment finished" already enforces in
+    # psi; a dwell in time would cancel the advancement, so none by default. s
+    min_time_state2_s: float = 0.0
     # ... with the CoM this far in front of the soles' heel edge (SPEC 7:
     # feet forces alone fired with the CoM behind the heels). m.
     com_ahead_of_heels_m: float = 0.03
     # 3 -> 4: each foot carries this much (SPEC 3)... N
     foot_force_3to4_N: float = 95.0
-    # ... after at least this long in state 3 (SPEC 3). s
-    min_time_state3_s: float = 0.5
+    # ... after at least this long in state 3 (SPEC 3: 0.5 s, the segment's
+    # length; enforced in psi as for state 2). s
+    min_time_state3_s: float = 0.0
     # The seat's normal-force bound ramps to zero over this time after the
     # switch to state 3 (SPEC 7). s.
     seat_release_s: float = 1.0
@@ -205,8 +215,12 @@ class SeatHoldConfig:
 class FallConfig:
     """Bounds that end a run early as a fall (success false, reason recorded)."""
 
+    # Seated the root is at 0.38 m, standing ~0.6 m. m.
     min_root_height_m: float = 0.25
     max_com_horizontal_m: float = 0.5
+    # The controller holds its last torques through a failed QP; this long a
+    # run of failures ends the run. s.
+    max_qp_failure_streak_s: float = 0.1
 
 
 @dataclass
@@ -251,6 +265,10 @@ class Scenario:
     human: HumanConfig = field(default_factory=HumanConfig)
     advancement: AdvancementConfig = field(default_factory=AdvancementConfig)
     standup: StandupConfig = field(default_factory=StandupConfig)
+    # The momentum-based whole-body controller (drake_standup/controller.py).
+    controller: ControllerConfig = field(default_factory=ControllerConfig)
+    # Its rate: 1 kHz (SPEC 3: the authors ran 100 Hz; run ours at >= 200 Hz). s.
+    controller_period_s: float = 0.001
     initial: InitialPose = field(default_factory=InitialPose)
     chair: ChairConfig = field(default_factory=ChairConfig)
     seat_hold: SeatHoldConfig = field(default_factory=SeatHoldConfig)
@@ -375,6 +393,7 @@ def validate(scenario: Scenario) -> None:
     _positive("plant.time_step", scenario.plant.time_step, allow_zero=True)
     _positive("robot.effort_limit_Nm", scenario.robot.effort_limit_Nm)
     _positive("log_period_s", scenario.log_period_s, allow_zero=False)
+    _positive("controller_period_s", scenario.controller_period_s)
     _positive("visualization.publish_period_s", scenario.visualization.publish_period_s)
     _positive("robot.visual_max_faces", scenario.robot.visual_max_faces)
     if not _resolve(scenario.chair.file).is_file():
@@ -435,6 +454,7 @@ def _validate_advancement(adv: AdvancementConfig) -> None:
         )
     _positive("advancement.eps", adv.eps)
     _positive("advancement.alpha_min_mps2", adv.alpha_min_mps2, allow_zero=True)
+    _positive("advancement.lag_tolerance_m", adv.lag_tolerance_m, allow_zero=True)
     _positive("advancement.psi_ddot_filter_s", adv.psi_ddot_filter_s)
 
 

@@ -13,6 +13,7 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Ve
 from drake_standup.advancement import TrajectoryAdvancement
 from drake_standup.config import Scenario
 from drake_standup.contacts import ContactForceReporter
+from drake_standup.controller import WholeBodyController
 from drake_standup.human import HumanWrenchSource
 from drake_standup.reference import CoMReferenceGenerator
 from drake_standup.scene import Scene, add_scene, set_seated_state
@@ -29,6 +30,7 @@ class StandupDiagram:
     pad_groups: dict[str, str]  # pad geometry name -> group, in reporter order
     state_machine: StandupStateMachine
     advancement: TrajectoryAdvancement
+    controller: WholeBodyController | None
     logs: dict[str, VectorLogSink]  # signal name -> logger
     visualizer: MeshcatVisualizer | None
 
@@ -38,30 +40,29 @@ def _seat_hold_gains(scenario: Scenario, joint_names: list[str]) -> dict:
     return {name: (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad) for name in joint_names}
 
 
-def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> StandupDiagram:
-    """Plant, seat hold, contact-force reporter, loggers and (optionally) Meshcat."""
+CONTROLLERS = ("whole_body", "seat_hold")
+
+
+def build_diagram(
+    scenario: Scenario, meshcat: Meshcat | None = None, controller: str = "whole_body"
+) -> StandupDiagram:
+    """The stand-up diagram: plant, human, advancement, reference, state machine,
+    the controller, loggers and (optionally) Meshcat.
+
+    controller: 'whole_body' (the momentum-based controller) or 'seat_hold'
+    (Drake's joint PD holding the seated pose; the plant-only benchmark).
+    """
+    if controller not in CONTROLLERS:
+        raise ValueError(f"controller: '{controller}'; accepted: {', '.join(CONTROLLERS)}")
     builder = DiagramBuilder()
-    # The robot's joint names are known only once it is parsed; every iCub
-    # model of icub-models names its 32 revolute joints alike, so the gains map
-    # is built from the scenario's pose keys plus a parse-free default.
-    scene = add_scene(builder, scenario, pd_gains=_AllJoints(scenario))
+    # Every iCub model of icub-models names its revolute joints alike; the
+    # seat hold gives them all the same gains.
+    pd_gains = _AllJoints(scenario) if controller == "seat_hold" else None
+    scene = add_scene(builder, scenario, pd_gains=pd_gains)
     plant = scene.plant
     instance = scene.robot.model_instance
-
-    # Seat hold: Drake's implicit joint PD toward the seated pose plus constant
-    # gravity feed-forward evaluated at that pose (the chair carries the base).
-    plant_context = plant.CreateDefaultContext()
-    set_seated_state(scene, plant_context, scenario)
-    q0 = plant.GetPositions(plant_context, instance)
-    B = plant.MakeActuationMatrix()
-    tau_g = plant.CalcGravityGeneralizedForces(plant_context)
-    u_ff = B.T @ (-tau_g)
-    Bq = _actuated_position_selector(plant, instance)
-    desired_state = np.concatenate([Bq @ q0, np.zeros(Bq.shape[0])])
-    setpoint = builder.AddNamedSystem("seat_hold_setpoint", ConstantVectorSource(desired_state))
-    feedforward = builder.AddNamedSystem("seat_hold_feedforward", ConstantVectorSource(u_ff))
-    builder.Connect(setpoint.get_output_port(), plant.get_desired_state_input_port(instance))
-    builder.Connect(feedforward.get_output_port(), plant.get_actuation_input_port(instance))
+    if controller == "seat_hold":
+        _add_seat_hold(builder, scene, scenario)
 
     # Group names as metrics.json reports them (plural where there are two).
     group_labels = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
@@ -100,11 +101,10 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
     builder.Connect(robot_state, human.GetInputPort("robot_state"))
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
     builder.Connect(hand_wrenches, sensing.GetInputPort("hand_wrenches_W"))
-    for name in ("com_velocity_W", "omega_f_W"):
+    for name in ("com_W", "com_velocity_W", "omega_f_W"):
         builder.Connect(sensing.GetOutputPort(name), advancement.GetInputPort(name))
-    builder.Connect(
-        reference.GetOutputPort("path_tangent_W"), advancement.GetInputPort("path_tangent_W")
-    )
+    for name in ("x_d_W", "path_tangent_W"):
+        builder.Connect(reference.GetOutputPort(name), advancement.GetInputPort(name))
     for name in ("psi", "psi_dot", "psi_ddot"):
         builder.Connect(advancement.GetOutputPort(name), reference.GetInputPort(name))
     builder.Connect(state_machine.GetOutputPort("segment"), reference.GetInputPort("segment"))
@@ -113,6 +113,26 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
     builder.Connect(sensing.GetOutputPort("heel_x_W"), state_machine.GetInputPort("heel_x_W"))
     builder.Connect(reporter.get_output_port(), state_machine.GetInputPort("pad_forces_W"))
     builder.Connect(hand_wrenches, state_machine.GetInputPort("hand_wrenches_W"))
+
+    controller_system = None
+    if controller == "whole_body":
+        controller_system = builder.AddNamedSystem(
+            "controller",
+            WholeBodyController(plant, robot, scenario.controller, scenario.controller_period_s),
+        )
+        builder.Connect(robot_state, controller_system.GetInputPort("robot_state"))
+        builder.Connect(
+            reference.GetOutputPort("com_reference"),
+            controller_system.GetInputPort("com_reference"),
+        )
+        builder.Connect(
+            state_machine.GetOutputPort("contact_plan"),
+            controller_system.GetInputPort("contact_plan"),
+        )
+        builder.Connect(hand_wrenches, controller_system.GetInputPort("hand_wrenches_W"))
+        builder.Connect(
+            controller_system.GetOutputPort("actuation"), plant.get_actuation_input_port(instance)
+        )
 
     logged = {
         "robot_state": robot_state,
@@ -127,6 +147,8 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
         "segment": state_machine.GetOutputPort("segment"),
         "net_actuation": plant.get_net_actuation_output_port(instance),
     }
+    if controller_system is not None:
+        logged["controller_diagnostics"] = controller_system.GetOutputPort("diagnostics")
     logs = {}
     for name, port in logged.items():
         logs[name] = LogVectorOutput(port, builder, scenario.log_period_s)
@@ -153,7 +175,28 @@ def build_diagram(scenario: Scenario, meshcat: Meshcat | None = None) -> Standup
 
     diagram = builder.Build()
     diagram.set_name("standup")
-    return StandupDiagram(diagram, scene, pad_groups, state_machine, advancement, logs, visualizer)
+    return StandupDiagram(
+        diagram, scene, pad_groups, state_machine, advancement, controller_system, logs, visualizer
+    )
+
+
+def _add_seat_hold(builder: DiagramBuilder, scene: Scene, scenario: Scenario) -> None:
+    """Drake's implicit joint PD toward the seated pose plus constant gravity
+    feed-forward evaluated at that pose (the chair carries the base)."""
+    plant = scene.plant
+    instance = scene.robot.model_instance
+    plant_context = plant.CreateDefaultContext()
+    set_seated_state(scene, plant_context, scenario)
+    q0 = plant.GetPositions(plant_context, instance)
+    B = plant.MakeActuationMatrix()
+    tau_g = plant.CalcGravityGeneralizedForces(plant_context)
+    u_ff = B.T @ (-tau_g)
+    Bq = _actuated_position_selector(plant, instance)
+    desired_state = np.concatenate([Bq @ q0, np.zeros(Bq.shape[0])])
+    setpoint = builder.AddNamedSystem("seat_hold_setpoint", ConstantVectorSource(desired_state))
+    feedforward = builder.AddNamedSystem("seat_hold_feedforward", ConstantVectorSource(u_ff))
+    builder.Connect(setpoint.get_output_port(), plant.get_desired_state_input_port(instance))
+    builder.Connect(feedforward.get_output_port(), plant.get_actuation_input_port(instance))
 
 
 class _AllJoints(dict):

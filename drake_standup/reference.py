@@ -43,9 +43,9 @@ def path(segment: np.ndarray, psi: float) -> tuple[np.ndarray, np.ndarray, np.nd
 class CoMReferenceGenerator(LeafSystem):
     """Inputs psi, psi_dot, psi_ddot (1 each), segment (8, from the state machine).
 
-    Outputs com_reference (9: [x_d, xd_dot, xd_ddot], world) and
-    path_tangent_W (3: d_psi x_d, which depends on psi and segment only, so
-    the advancement can use it without an algebraic loop).
+    Outputs com_reference (9: [x_d, xd_dot, xd_ddot], world), and x_d_W (3)
+    and path_tangent_W (3: d_psi x_d), which depend on psi and segment only,
+    so the advancement can use them without an algebraic loop.
     """
 
     def __init__(self):
@@ -55,11 +55,12 @@ class CoMReferenceGenerator(LeafSystem):
         self._psi_ddot = self.DeclareVectorInputPort("psi_ddot", 1)
         self._segment = self.DeclareVectorInputPort("segment", SEGMENT_SIZE)
         self.DeclareVectorOutputPort("com_reference", 9, self._CalcReference)
+        path_only = {self._psi.ticket(), self._segment.ticket()}
         self.DeclareVectorOutputPort(
-            "path_tangent_W",
-            3,
-            self._CalcTangent,
-            prerequisites_of_calc={self._psi.ticket(), self._segment.ticket()},
+            "x_d_W", 3, self._CalcPosition, prerequisites_of_calc=path_only
+        )
+        self.DeclareVectorOutputPort(
+            "path_tangent_W", 3, self._CalcTangent, prerequisites_of_calc=path_only
         )
 
     def _CalcReference(self, context: Context, output: BasicVector) -> None:
@@ -69,6 +70,10 @@ class CoMReferenceGenerator(LeafSystem):
         output.SetFromVector(
             np.concatenate([x_d, d_x * psi_dot, dd_x * psi_dot**2 + d_x * psi_ddot])
         )
+
+    def _CalcPosition(self, context: Context, output: BasicVector) -> None:
+        x_d, _, _ = path(self._segment.Eval(context), self._psi.Eval(context)[0])
+        output.SetFromVector(x_d)
 
     def _CalcTangent(self, context: Context, output: BasicVector) -> None:
         _, d_x, _ = path(self._segment.Eval(context), self._psi.Eval(context)[0])

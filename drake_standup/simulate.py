@@ -5,6 +5,7 @@ The one function that run_diagram.py, the benchmark and the sweeps call.
 
 from __future__ import annotations
 
+import copy
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -60,9 +61,54 @@ def simulate(
     *,
     record: bool = True,
     progress: bool = True,
+    baseline: bool = False,
     chunk_s: float = 0.05,
 ) -> RunResult:
-    """Simulates scenario; writes recording, metrics and diagram into out_dir."""
+    """Simulates scenario; writes recording, metrics, figures and diagram into out_dir.
+
+    baseline: also simulate the same scenario with advancement disabled (psi = t),
+    for the faded reference of figure_advancement.png and the metric
+    standup_time_s_without_advancement. Where nothing could advance psi (no
+    human, or advancement already off) the run is its own baseline.
+    """
+    base = None
+    if baseline and scenario.advancement.enabled and _human_acts(scenario):
+        base_scenario = copy.deepcopy(scenario)
+        base_scenario.advancement.enabled = False
+        base = _simulate_one(
+            base_scenario,
+            None,
+            record=False,
+            progress=progress,
+            chunk_s=chunk_s,
+            label="baseline (psi = t)",
+        )
+    result = _simulate_one(
+        scenario,
+        out_dir,
+        record=record,
+        progress=progress,
+        chunk_s=chunk_s,
+        label="simulating",
+        baseline=base,
+    )
+    return result
+
+
+def _human_acts(scenario: Scenario) -> bool:
+    return scenario.human.mode == "reactive" or bool(scenario.human.pulls)
+
+
+def _simulate_one(
+    scenario: Scenario,
+    out_dir: Path | None,
+    *,
+    record: bool,
+    progress: bool,
+    chunk_s: float,
+    label: str,
+    baseline: RunResult | None = None,
+) -> RunResult:
     meshcat = make_meshcat() if record else None
     t_build = time.perf_counter()
     built = build_diagram(scenario, meshcat)
@@ -83,7 +129,7 @@ def simulate(
         built.visualizer.StartRecording(set_transforms_while_recording=False)
 
     failure_reason = None
-    bar = ProgressBar(scenario.duration_s, "simulating") if progress else None
+    bar = ProgressBar(scenario.duration_s, label) if progress else None
     t_wall = time.perf_counter()
     try:
         simulator.Initialize()
@@ -105,6 +151,13 @@ def simulate(
 
     result = _collect(built, root_context, scenario)
     sim_time_s = root_context.get_time()
+    standing = result.metrics.get("standing_at_end", False)
+    if failure_reason is None and built.controller is not None and not standing:
+        failure_reason = (
+            "did not stand up"
+            if result.metrics.get("standup_time_s") is None
+            else "stood up but was not standing at the end"
+        )
     result.metrics.update(
         success=failure_reason is None,
         failure_reason=failure_reason,
@@ -116,6 +169,10 @@ def simulate(
     )
     result.metrics = {k: result.metrics[k] for k in _ordered(result.metrics)}
 
+    if baseline is not None:
+        result.metrics["standup_time_s_without_advancement"] = baseline.metrics.get(
+            "standup_time_s"
+        )
     if out_dir is not None:
         out_dir = Path(out_dir)
         out_dir.mkdir(parents=True, exist_ok=True)
@@ -127,6 +184,15 @@ def simulate(
             result.files["recording"] = path
         for p in outputs.export_diagram(built.diagram, out_dir / "diagrams"):
             result.files[p.suffix.lstrip(".")] = p
+        entries = result.metrics.get("state_entry_times_s", [])
+        path = out_dir / "figure_advancement.png"
+        outputs.figure_advancement(
+            result.signals, baseline.signals if baseline else None, entries, path
+        )
+        result.files["figure_advancement"] = path
+        path = out_dir / "figure_tracking.png"
+        outputs.figure_tracking(result.signals, built.pad_groups, entries, path)
+        result.files["figure_tracking"] = path
         path = out_dir / "metrics.json"
         outputs.write_metrics(path, result.metrics)
         result.files["metrics"] = path
@@ -139,7 +205,8 @@ def _ordered(metrics: dict) -> list[str]:
 
 
 class _FallMonitor:
-    """Simulator monitor: stops the run when the robot has fallen.
+    """Simulator monitor: stops the run when the robot has fallen or the
+    controller's QP has stayed infeasible for max_qp_failure_streak_s.
 
     Checks the floating base only (cheap each step): its height, and its
     horizontal distance from where it started.
@@ -151,6 +218,9 @@ class _FallMonitor:
         self._min_z = scenario.fall.min_root_height_m
         self._max_xy = scenario.fall.max_com_horizontal_m
         self._xy0 = np.array(scenario.initial.base_xyz_m[:2])
+        self._controller = built.controller
+        self._max_streak_s = scenario.fall.max_qp_failure_streak_s
+        self._failing_since: float | None = None
         self.reason: str | None = None
 
     def __call__(self, root_context) -> EventStatus:
@@ -167,9 +237,25 @@ class _FallMonitor:
                 f"fall: root_link moved {np.linalg.norm(p_WB[:2] - self._xy0):.3f} m "
                 f"horizontally at t = {root_context.get_time():.3f} s"
             )
+        elif self._controller is not None:
+            self._check_qp(root_context)
         if self.reason is not None:
             return EventStatus.ReachedTermination(None, self.reason)
         return EventStatus.DidNothing()
+
+    def _check_qp(self, root_context) -> None:
+        t = root_context.get_time()
+        context = self._controller.GetMyContextFromRoot(root_context)
+        qp_ok = self._controller.GetOutputPort("diagnostics").Eval(context)[0]
+        if qp_ok:
+            self._failing_since = None
+        elif self._failing_since is None:
+            self._failing_since = t
+        elif t - self._failing_since >= self._max_streak_s:
+            self.reason = (
+                f"controller: QP infeasible since t = {self._failing_since:.3f} s "
+                f"({t - self._failing_since:.2f} s)"
+            )
 
 
 def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResult:
@@ -200,6 +286,9 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
     metrics.update(
         outputs.standup_metrics(signals, built.pad_groups, metrics["state_entry_times_s"])
     )
+    if "controller_diagnostics" in signals:
+        diagnostics = signals["controller_diagnostics"][1]
+        metrics["qp_failures"] = int(diagnostics[1, -1]) if diagnostics.size else 0
     torques = signals["net_actuation"][1]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
     result.metrics = metrics

@@ -9,7 +9,7 @@ import pytest
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.analysis import Simulator
 
-from drake_standup.advancement import TrajectoryAdvancement, psi_dot_law
+from drake_standup.advancement import TrajectoryAdvancement, lead, psi_dot_law
 from drake_standup.config import AdvancementConfig
 from drake_standup.robot import ContactModel, add_icub
 from drake_standup.sensing import RobotSensing
@@ -89,6 +89,9 @@ def test_interaction_law_value_matches_the_authors_ratio():
 def _simulate_advancement(cfg, v, omega_f, tangent, t_end):
     system = TrajectoryAdvancement(cfg)
     context = system.CreateDefaultContext()
+    # CoM on its reference: the lead gate is open.
+    system.GetInputPort("com_W").FixValue(context, np.zeros(3))
+    system.GetInputPort("x_d_W").FixValue(context, np.zeros(3))
     system.GetInputPort("com_velocity_W").FixValue(context, v)
     system.GetInputPort("omega_f_W").FixValue(context, omega_f)
     system.GetInputPort("path_tangent_W").FixValue(context, tangent)
@@ -113,6 +116,21 @@ def test_psi_integrates_the_law():
     assert system.GetOutputPort("psi").Eval(context)[0] == pytest.approx(2.0 * ratio, rel=1e-9)
     # psi_ddot is the derivative of the low-passed psi_dot: decayed after 40 tau.
     assert abs(system.GetOutputPort("psi_ddot").Eval(context)[0]) < 1e-6
+
+
+def test_lead_gate_waits_while_the_com_lags():
+    """Helped and fast, but 1 cm behind the reference along the path: no
+    advancement with the gate (the default), the paper's ratio without it."""
+    v = 1.8 * TANGENT
+    omega_f = TANGENT / np.linalg.norm(TANGENT)
+    x_d = np.array([0.2, 0.0, 0.4])
+    behind = x_d - 0.01 * TANGENT / np.linalg.norm(TANGENT)
+    lag = lead(behind, x_d, TANGENT)
+    assert lag == pytest.approx(-0.01)
+    assert psi_dot_law(CFG, v, omega_f, TANGENT, lag)[0] == 1.0
+    assert psi_dot_law(_cfg(lead_gate=False), v, omega_f, TANGENT, lag)[0] > 1.7
+    # Within the tolerance (the tracker's steady lag) it advances.
+    assert psi_dot_law(CFG, v, omega_f, TANGENT, -0.004)[0] > 1.7
 
 
 def test_omega_f_is_total_hand_force_over_mass():

@@ -43,5 +43,5 @@ def test_dot_names_every_system():
     assert len(names) >= 6
     for name in names:
         assert name in dot, name
-    for expected in ("plant", "scene_graph", "contact_forces", "seat_hold_setpoint"):
+    for expected in ("plant", "scene_graph", "contact_forces", "controller"):
         assert expected in names

@@ -21,10 +21,14 @@ def _urdf_mass_kg(model: str) -> float:
     return sum(float(m.get("value")) for m in root.iter("mass"))
 
 
-def test_run_succeeds_and_writes_outputs(seated_run):
+def test_run_completes_and_writes_outputs(seated_run):
+    """Nobody pulls and the stand-up waits for a pull: the robot balances on
+    the chair for the whole run. "success" means stood up, so it is false with
+    exactly that reason, not a fall or a solver failure."""
     _, result, out = seated_run
-    assert result.metrics["success"] is True
-    assert result.metrics["failure_reason"] is None
+    assert result.metrics["success"] is False
+    assert result.metrics["failure_reason"] == "did not stand up"
+    assert result.metrics["qp_failures"] == 0
     for name in ("recording.html", "metrics.json", "diagrams/standup.dot"):
         assert (out / name).is_file(), name
     metrics = json.loads((out / "metrics.json").read_text())

@@ -1,0 +1,616 @@
+"""WholeBodyController: the momentum-based whole-body torque controller (SPEC 2, 3, 7).
+
+A thin LeafSystem around drake_standup/control/: every period_s it reads the robot's
+state, the CoM reference, the contact plan and the measured hand wrenches, solves one QP
+over [contact wrenches, vdot] (control/qp.py) and holds the resulting joint torques.
+
+Ports
+    robot_state      (nq + nv)  [q (quaternion wxyz, p_WB, joints); v (w_WB, v_WB, joints)]
+    com_reference    (9)        [x_d, xd_dot, xd_ddot], world, m, m/s, m/s^2
+    contact_plan     (3)        [standup_state 1-4, seat_scale 0-1, feet_scale 0-1]
+    hand_wrenches_W  (12)       [tau_l, f_l, tau_r, f_r], world, at the hand frames' origins
+    -> actuation     (nu)       joint torques, actuator order, N m (zero-order held)
+    -> diagnostics   (10)       see DIAGNOSTICS
+
+Contacts: the seat (a 6-D contact on root_link under the buttocks), both thighs (point
+forces on the thigh pads) and both soles (6-D). The seat and soles are held by the QP
+(their frames do not accelerate); the thighs are then pinned already and carry forces
+only. From state 2 on, the seat lets the pelvis pitch about the hip axis (the thighs stay
+on the chair) so that the trunk can bring the CoM over the feet.
+
+Contact plan: seat_scale scales the seat's and thighs' normal-force bounds (the plan
+ramps it to 0 to release the seat; at 0 they are dropped); feet_scale scales the soles'
+minimum normal force (0 drops them). standup_state picks the CoM gains (seated 1-2,
+standing 3-4), the base pitch and the posture reference (state 1: the posture at the
+first tick).
+"""
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
+
+from drake_standup.control.contacts import NORMAL, WRENCH_SIZE, ContactSpec
+from drake_standup.control.qp import SOLVERS, ContactCommand, QpLayout, QpSolution, WholeBodyQp
+from drake_standup.control.spatial import yaw_pitch_rotation
+from drake_standup.control.tasks import (
+    base_orientation_task,
+    com_acceleration_reference,
+    cop_centering_task,
+    hand_wrench_about_com,
+    helpful_force,
+    joint_limit_acceleration_bounds,
+    momentum_task,
+    posture_task,
+)
+from drake_standup.control.terms import BASE_BODY, RobotKinematics, RobotTerms
+from drake_standup.robot import Robot
+
+_POSTURE_JOINTS = (
+    "hip_pitch",
+    "hip_roll",
+    "knee",
+    "ankle_pitch",
+    "shoulder_pitch",
+    "shoulder_roll",
+    "shoulder_yaw",
+    "elbow",
+)
+
+
+def _posture(values: list[float]) -> dict[str, float]:
+    """SPEC 3 posture row [hip pitch, roll, knee, ankle pitch | shoulder pitch, roll, yaw,
+    elbow | torso pitch], both sides alike, as joint name -> rad."""
+    posture = {
+        f"{side}_{joint}": value
+        for side in "lr"
+        for joint, value in zip(_POSTURE_JOINTS, values[:8], strict=True)
+    }
+    posture["torso_pitch"] = values[8]
+    return posture
+
+
+@dataclass
+class ControllerConfig:
+    """Gains, weights and contact limits of the whole-body controller."""
+
+    # CoM stiffness K_P (x, y, z) in states 1-2: a soft z lets the forward lean lower the
+    # CoM (SPEC 7: equal gains stalled it 4-7 cm short of the feet). 1/s^2.
+    com_kp_seated_per_s2: list[float] = field(default_factory=lambda: [60.0, 40.0, 5.0])
+    # CoM stiffness K_P in states 3-4: z raised to lift the robot (SPEC 7). 1/s^2.
+    com_kp_standing_per_s2: list[float] = field(default_factory=lambda: [60.0, 40.0, 30.0])
+    # K_D = 2 zeta sqrt(K_P), critically damped (SPEC 7).
+    com_damping_ratio: float = 1.0
+    # Angular momentum: Ldot_ang* = -K_D L_ang - K_P int L_ang; K_P,ang = 1 (SPEC 3). 1/s^2.
+    angular_momentum_kp_per_s2: float = 1.0
+    # Angular momentum damping K_D,ang (SPEC 7 probe: 5). 1/s.
+    angular_momentum_kd_per_s: float = 5.0
+    # Joint posture: qddot* = -K_P (q - q_ref) - K_D qdot (SPEC 7 probe: 30). 1/s^2.
+    posture_kp_per_s2: float = 30.0
+    # K_D = 2 zeta sqrt(K_P) for the posture, critically damped.
+    posture_damping_ratio: float = 1.0
+    # Time constant of the first-order filter that moves q_ref to a new state's table:
+    # a step would ask for large joint accelerations at each switch. s.
+    posture_filter_time_constant_s: float = 0.3
+    # Posture targets are clamped this far inside the joint limits: SPEC 3's elbow target
+    # 0.2473 rad lies below the URDF's 0.262 limit. rad.
+    posture_limit_margin_rad: float = 0.05
+    # Joints off the legs (torso, neck, arms) get acceleration bounds that stop them at
+    # their limits within this horizon (control/tasks.py): without them the arms, swung to
+    # move the CoM in state 2, hit the shoulder-pitch limit and the jolt threw the pelvis
+    # off the seat (measured). The legs get none: the held soles pin their accelerations,
+    # and a bound could make the QP infeasible (it did, on random states). s.
+    joint_limit_horizon_s: float = 0.1
+    # Base (root_link) orientation: upright at the yaw of the first tick, pitched forward
+    # by base_pitch_by_state_rad. The probe ended stooped 25 deg (SPEC 7). 1/s^2.
+    base_orientation_kp_per_s2: float = 30.0
+    # K_D = 2 zeta sqrt(K_P) for the base orientation.
+    base_orientation_damping_ratio: float = 1.0
+    # Base pitch targets in states 1-4 (positive: forward): a human tilts the pelvis
+    # forward to bring the trunk over the feet, then stands upright (measured: an upright
+    # pelvis and the torso at its 1.22 rad limit left the CoM 3 cm short of the 2->3
+    # guard). rad.
+    base_pitch_by_state_rad: list[float] = field(default_factory=lambda: [0.0, 0.4, 0.3, 0.0])
+    # From this state on the seat lets the pelvis pitch about the hip axis (the mid-point
+    # of these joints' frames on root_link), the base orientation task steering it.
+    seat_hinge_from_state: int = 2
+    seat_hinge_joints: list[str] = field(default_factory=lambda: ["l_hip_pitch", "r_hip_pitch"])
+    # Task weights (QP cost, per squared residual): momentum (N, N m) dominates; posture
+    # and base orientation (rad/s^2) act in what is left. The momentum rate is made by
+    # accelerating the body, which the posture task charges for: at a weight of 1 the
+    # momentum task gave up 1.7 N of a 51 N demand, at 100 0.05 N (measured).
+    momentum_weight: float = 100.0
+    # Posture weight per joint (measured: at 0.01 the QP swung the arms onto their limits
+    # to make momentum, 57 N m peaks in the pulled stand-up; at 0.1, 25 N m).
+    posture_weight: float = 0.1
+    # Per-joint posture weights that replace posture_weight: the torso holds its own
+    # against the twelve leg joints, whose targets the CoM task overrides anyway (with
+    # equal weights the robot stood with the trunk 0.5 rad forward, measured).
+    posture_weight_by_joint: dict[str, float] = field(
+        default_factory=lambda: {"torso_pitch": 1.0, "torso_roll": 1.0, "torso_yaw": 1.0}
+    )
+    # Base orientation weight: at 1 the stand-up ended with the pelvis 1.4 deg back, at 10
+    # 0.3 deg (measured).
+    base_orientation_weight: float = 10.0
+    # Each 6-D contact's CoP to the centre of its box (N m): it decides how the load is
+    # shared, which the momentum task leaves free, away from the box edges (measured).
+    cop_centering_weight: float = 1.0e-2
+    # Regularisation: joint torques (N m), contact wrenches (N, N m), accelerations; they
+    # make the Hessian positive definite (measured).
+    torque_weight: float = 1.0e-4
+    wrench_weight: float = 1.0e-5
+    acceleration_weight: float = 1.0e-6
+    # Linearised friction pyramid |f_t| <= mu f_z of the QP (SPEC 3; the pads have 1.0).
+    friction_coefficient: float = 1.0 / 3.0
+    # Torsional friction |tau_z| <= mu_t f_z (SPEC 3). m.
+    torsional_friction_coefficient_m: float = 1.0 / 75.0
+    # Minimum normal force of an active contact, scaled by the plan (SPEC 3). N.
+    min_normal_force_N: float = 10.0
+    # Seat (and each thigh) normal-force bound at seat_scale = 1: above the robot's weight
+    # (324 N), so it binds only while the plan ramps it down (SPEC 7 release). N.
+    seat_max_normal_force_N: float = 400.0
+    # Sole normal-force bound: three times the robot's weight, never binding. N.
+    foot_max_normal_force_N: float = 1000.0
+    # CoP box of each sole in its l_sole/r_sole frame (SPEC 3; inside the 0.19 x 0.09 m
+    # pads at x in [-0.064, 0.126], models/icub_contact.yaml). m.
+    foot_cop_x_m: list[float] = field(default_factory=lambda: [-0.05, 0.10])
+    foot_cop_y_m: list[float] = field(default_factory=lambda: [-0.025, 0.025])
+    # CoP box of the seat contact in its frame: the seat acts on root_link, whose only pad
+    # is the buttocks pad (x in [-0.12, -0.02], y in [-0.06, 0.06] of the seat frame,
+    # models/icub_contact.yaml), 1 cm inside; the thighs are contacts of their own. A box
+    # over the thigh pads (SPEC 7's +-0.11) let the QP ask for a CoP the buttocks cannot
+    # give and the pelvis rolled forward onto the thighs (measured). m.
+    seat_cop_x_m: list[float] = field(default_factory=lambda: [-0.11, -0.03])
+    seat_cop_y_m: list[float] = field(default_factory=lambda: [-0.05, 0.05])
+    # Joint torque saturation (SPEC 3). N m.
+    torque_limit_Nm: float = 60.0
+    # ||xd_dot|| below which the helpful part of the pull fades out (smoothstep): the
+    # standing robot compensates the whole pull (SPEC 7). m/s.
+    help_fade_speed_mps: float = 0.02
+    # CoM lead over its reference along the path at which the help is fully compensated:
+    # with psi = t a 30 N pull otherwise carried the CoM 6 cm past the standing height onto
+    # straight, locked knees (measured). m.
+    help_max_lead_m: float = 0.02
+    # Posture references by joint name, states 2-4 (SPEC 3; torso pitch 1.0 in state 2 from
+    # the SPEC 7 probe: a deep lean). Joints not named hold the state-1 posture. rad.
+    posture_state2_rad: dict[str, float] = field(
+        default_factory=lambda: _posture(
+            [1.5402, 0.1594, -1.7365, -0.2814, -1.6455, 0.4363, 0.5862, 0.2473, 1.0]
+        )
+    )
+    posture_state3_rad: dict[str, float] = field(
+        default_factory=lambda: _posture(
+            [1.1097, 0.0122, -0.8365, -0.0714, -1.4615, 0.4363, 0.1545, 0.2018, 0.0611]
+        )
+    )
+    posture_state4_rad: dict[str, float] = field(
+        default_factory=lambda: _posture(
+            [0.2094, 0.1047, -0.1745, -0.0349, -1.6455, 0.4363, 0.5862, 0.2473, 0.0]
+        )
+    )
+    # QP solver: daqp (measured fastest, exact equalities), or Drake's osqp / clarabel.
+    qp_solver: str = "daqp"
+
+
+def _contact_specs(
+    plant: MultibodyPlant, robot: Robot, config: ControllerConfig
+) -> list[ContactSpec]:
+    """Seat (held at the hip axis), both thighs (point forces, pinned by the others),
+    both soles."""
+    seat = robot.frame(plant, "seat")
+    context = plant.CreateDefaultContext()
+    p_SeatHinge = np.mean(
+        [
+            plant.GetJointByName(name, robot.model_instance)
+            .frame_on_parent()
+            .CalcPose(context, seat)
+            .translation()
+            for name in config.seat_hinge_joints
+        ],
+        axis=0,
+    )
+    friction = {
+        "friction_coefficient": config.friction_coefficient,
+        "torsional_friction_coefficient": config.torsional_friction_coefficient_m,
+    }
+    seat_box = {"cop_x_m": tuple(config.seat_cop_x_m), "cop_y_m": tuple(config.seat_cop_y_m)}
+    foot_box = {"cop_x_m": tuple(config.foot_cop_x_m), "cop_y_m": tuple(config.foot_cop_y_m)}
+    return [
+        ContactSpec("seat", **friction, **seat_box, hold_point_m=tuple(p_SeatHinge.tolist())),
+        ContactSpec("l_thigh", **friction, point=True, constrained=False),
+        ContactSpec("r_thigh", **friction, point=True, constrained=False),
+        ContactSpec("l_sole", **friction, **foot_box),
+        ContactSpec("r_sole", **friction, **foot_box),
+    ]
+
+
+@dataclass
+class _Joints:
+    """The actuated joints, in actuator order."""
+
+    names: list[str]
+    q_indices: np.ndarray  # index of each joint's angle in q
+    v_indices: np.ndarray  # index of each joint's rate in v
+    q_min: np.ndarray  # position limits, rad
+    q_max: np.ndarray
+    # True for a joint that moves none of the held frames (but the base): it gets
+    # joint-limit bounds.
+    limited: np.ndarray
+
+
+def _actuated_joints(plant: MultibodyPlant, robot: Robot, held_frames: list[str]) -> _Joints:
+    held_bodies = {robot.frame(plant, name).body().index() for name in held_frames}
+    held_bodies.discard(plant.GetBodyByName(BASE_BODY, robot.model_instance).index())
+    actuators = sorted(
+        (
+            plant.get_joint_actuator(index)
+            for index in plant.GetJointActuatorIndices(robot.model_instance)
+        ),
+        key=lambda actuator: actuator.input_start(),
+    )
+    joints = [actuator.joint() for actuator in actuators]
+    return _Joints(
+        names=[joint.name() for joint in joints],
+        q_indices=np.array([joint.position_start() for joint in joints]),
+        v_indices=np.array([joint.velocity_start() for joint in joints]),
+        q_min=np.array([joint.position_lower_limits()[0] for joint in joints]),
+        q_max=np.array([joint.position_upper_limits()[0] for joint in joints]),
+        limited=np.array(
+            [
+                not held_bodies & set(plant.GetBodiesKinematicallyAffectedBy([joint.index()]))
+                for joint in joints
+            ]
+        ),
+    )
+
+
+@dataclass
+class ControllerTick:
+    """One tick's solution and the controller's memory after it."""
+
+    solution: QpSolution  # for the active contacts only
+    terms: RobotTerms
+    normal_forces_N: np.ndarray  # commanded f_z of every contact (CONTACTS), 0 if inactive
+    helpful_force_W: np.ndarray  # f_par, N
+    posture: np.ndarray  # next value of the posture state (see __init__)
+    inputs_s: float  # evaluating the input ports (and the upstream systems behind them)
+    kinematics_s: float
+    assembly_s: float
+
+
+class WholeBodyController(LeafSystem):
+    """Momentum-based whole-body torque controller (module docstring)."""
+
+    CONTACTS = ("seat", "l_thigh", "r_thigh", "l_sole", "r_sole")
+    HANDS = ("l_hand", "r_hand")
+    # Layout of the diagnostics output.
+    DIAGNOSTICS = (
+        "qp_ok",  # 1 if this tick's QP succeeded, else 0 (torques held)
+        "qp_failures",  # failed QPs since the start
+        "solve_time_s",  # QP solver time this tick
+        "tick_time_s",  # whole tick: kinematics, assembly, solve
+        "seat_fz_N",  # commanded normal force, seat contact
+        "l_thigh_fz_N",  # commanded normal force, left thigh
+        "r_thigh_fz_N",  # commanded normal force, right thigh
+        "l_sole_fz_N",  # commanded normal force, left sole
+        "r_sole_fz_N",  # commanded normal force, right sole
+        "helpful_force_N",  # ||f_par||: the part of the pull the controller lets act
+    )
+    # Columns of timing_s().
+    TIMING = ("inputs_s", "kinematics_s", "assembly_s", "solve_s", "total_s")
+
+    def __init__(
+        self,
+        plant: MultibodyPlant,
+        robot: Robot,
+        config: ControllerConfig,
+        period_s: float = 0.001,
+    ):
+        super().__init__()
+        if config.qp_solver not in SOLVERS:
+            raise ValueError(
+                f"controller.qp_solver: '{config.qp_solver}'; accepted: {', '.join(SOLVERS)}"
+            )
+        self._config = config
+        self._period_s = period_s
+        self._B = plant.MakeActuationMatrix()
+        self._nv, self._nu = nv, nu = self._B.shape
+        self._gravity_W = plant.gravity_field().gravity_vector()
+        self.contact_specs = _contact_specs(plant, robot, config)
+        held_frames = [spec.frame for spec in self.contact_specs if spec.constrained]
+        self._joints = joints = _actuated_joints(plant, robot, held_frames)
+        self._posture_tables, self._posture_weights = self._posture_setup(config, joints.names)
+        self._kinematics = RobotKinematics(
+            plant,
+            robot,
+            held_frames=held_frames,
+            other_frames=[spec.frame for spec in self.contact_specs if not spec.constrained]
+            + list(self.HANDS),
+        )
+        # CoM gains (K_P, K_D) seated (True) and standing (False).
+        self._com_gains = {
+            seated: (np.array(kp), 2.0 * config.com_damping_ratio * np.sqrt(kp))
+            for seated, kp in (
+                (True, config.com_kp_seated_per_s2),
+                (False, config.com_kp_standing_per_s2),
+            )
+        }
+        # One program per set of active contacts, built when first needed.
+        self._programs: dict[tuple[bool, ...], WholeBodyQp] = {}
+        self._timing: list[tuple[float, ...]] = []
+
+        nx = plant.num_positions(robot.model_instance) + nv
+        self._state_port = self.DeclareVectorInputPort("robot_state", nx)
+        self._reference_port = self.DeclareVectorInputPort("com_reference", 9)
+        self._plan_port = self.DeclareVectorInputPort("contact_plan", 3)
+        self._hands_port = self.DeclareVectorInputPort("hand_wrenches_W", 12)
+        self._actuation = self.DeclareDiscreteState(nu)
+        self._diagnostics = self.DeclareDiscreteState(len(self.DIAGNOSTICS))
+        self._momentum_integral = self.DeclareDiscreteState(3)  # int L_ang dt, N m s^2
+        # [latched flag, state-1 posture (nu), filtered posture reference (nu), base yaw].
+        self._posture = self.DeclareDiscreteState(2 + 2 * nu)
+        self.DeclareStateOutputPort("actuation", self._actuation)
+        self.DeclareStateOutputPort("diagnostics", self._diagnostics)
+        # Initialization event: the plant's first step already sees computed torques.
+        self.DeclareInitializationDiscreteUpdateEvent(self._Update)
+        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
+
+    @staticmethod
+    def _posture_setup(
+        config: ControllerConfig, names: list[str]
+    ) -> tuple[dict[int, np.ndarray], np.ndarray]:
+        """Posture tables by state (actuator order, NaN: hold the state-1 posture) and
+        the per-joint posture weights; unknown joint names are an error."""
+        tables = {1: np.full(len(names), np.nan)}
+        named = {
+            "posture_state2_rad": config.posture_state2_rad,
+            "posture_state3_rad": config.posture_state3_rad,
+            "posture_state4_rad": config.posture_state4_rad,
+            "posture_weight_by_joint": config.posture_weight_by_joint,
+        }
+        for key, table in named.items():
+            unknown = sorted(set(table) - set(names))
+            if unknown:
+                raise ValueError(f"controller.{key}: unknown joint(s) {', '.join(unknown)}")
+        for state in (2, 3, 4):
+            table = named[f"posture_state{state}_rad"]
+            tables[state] = np.array([table.get(name, np.nan) for name in names])
+        weights = np.array(
+            [config.posture_weight_by_joint.get(name, config.posture_weight) for name in names]
+        )
+        return tables, weights
+
+    # --- Timing --------------------------------------------------------------------
+
+    def timing_s(self) -> np.ndarray:
+        """Per-tick compute times since construction (or reset_timing), (ticks, 5), in
+        the columns of TIMING: input ports (including the upstream systems' outputs they
+        evaluate), kinematics/dynamics terms, tasks + QP assembly, QP solve, and the whole
+        discrete update."""
+        return np.array(self._timing).reshape(-1, len(self.TIMING))
+
+    def reset_timing(self) -> None:
+        self._timing.clear()
+
+    # --- One tick ------------------------------------------------------------------
+
+    def CalcTick(self, context: Context) -> ControllerTick:
+        """Solves the QP for the inputs and discrete state in context (no side effects)."""
+        config = self._config
+        t_start = time.perf_counter()
+        x = self._state_port.Eval(context)
+        com_reference = self._reference_port.Eval(context)
+        standup_state, seat_scale, feet_scale = self._plan_port.Eval(context)
+        F_hand_W = self._hands_port.Eval(context)
+        t_inputs = time.perf_counter()
+
+        standup_state = min(max(int(round(standup_state)), 1), 4)
+        scales = {"seat": seat_scale, "l_thigh": seat_scale, "r_thigh": seat_scale}
+        scales.update(l_sole=feet_scale, r_sole=feet_scale)
+        active = tuple(scales[spec.frame] > 0.0 for spec in self.contact_specs)
+        program = self._program(active)
+        pulled = bool(np.any(F_hand_W))
+        frames = [spec.frame for spec in program.contacts] + (list(self.HANDS) if pulled else [])
+        terms = self._kinematics.calc(x, frames)
+        t_kinematics = time.perf_counter()
+
+        # Centroidal momentum: xddot*, the helpful part of the pull, Ldot*.
+        kp_com, kd_com = self._com_gains[standup_state <= 2]
+        xddot_star = com_acceleration_reference(
+            terms.p_WCom, terms.v_WCom, com_reference, kp_com, kd_com
+        )
+        f_par = np.zeros(3)
+        if pulled:
+            xd_dot = com_reference[3:6]
+            speed = np.linalg.norm(xd_dot)
+            lead_m = (terms.p_WCom - com_reference[:3]) @ xd_dot / speed if speed > 0.0 else 0.0
+            f_par = helpful_force(
+                F_hand_W[3:6] + F_hand_W[9:12],
+                xd_dot,
+                lead_m,
+                config.help_fade_speed_mps,
+                config.help_max_lead_m,
+            )
+        momentum_integral = context.get_discrete_state(self._momentum_integral).value()
+        Ldot_star = np.concatenate(
+            [
+                -config.angular_momentum_kd_per_s * terms.L_WCom[:3]
+                - config.angular_momentum_kp_per_s2 * momentum_integral,
+                terms.mass_kg * xddot_star + f_par,
+            ]
+        )
+        tau_hand = np.zeros(self._nv)
+        W_hand_Com = np.zeros(6)
+        if pulled:
+            tau_hand = sum(
+                terms.frames[name].J_WF.T @ F_hand_W[6 * k : 6 * (k + 1)]
+                for k, name in enumerate(self.HANDS)
+            )
+            W_hand_Com = hand_wrench_about_com(terms, list(self.HANDS), F_hand_W)
+        tasks = [
+            momentum_task(
+                terms,
+                program.layout,
+                program.contacts,
+                Ldot_star,
+                W_hand_Com,
+                self._gravity_W,
+                config.momentum_weight,
+            )
+        ]
+        posture, posture_tasks = self._posture_tasks(context, terms, standup_state, program)
+        tasks += posture_tasks
+
+        commands = self._contact_commands(program.contacts, standup_state, scales)
+        vdot_min, vdot_max = self._joint_limit_bounds(terms)
+        t_tasks = time.perf_counter()
+        solution = program.solve(terms, tasks, commands, tau_hand, vdot_min, vdot_max)
+
+        normal_forces_N = np.zeros(len(self.CONTACTS))
+        for frame, F in zip(solution.frames, solution.F_C, strict=True):
+            normal_forces_N[self.CONTACTS.index(frame)] = F[NORMAL]
+        return ControllerTick(
+            solution=solution,
+            terms=terms,
+            normal_forces_N=normal_forces_N,
+            helpful_force_W=f_par,
+            posture=posture,
+            inputs_s=t_inputs - t_start,
+            kinematics_s=t_kinematics - t_inputs,
+            assembly_s=t_tasks - t_kinematics + solution.assembly_s,
+        )
+
+    def _program(self, active: tuple[bool, ...]) -> WholeBodyQp:
+        """The QP over the active contacts (built at the first tick that needs it)."""
+        if active not in self._programs:
+            config = self._config
+            contacts = [spec for spec, on in zip(self.contact_specs, active, strict=True) if on]
+            layout = QpLayout.of(contacts, self._nv)
+            self._programs[active] = WholeBodyQp(
+                contacts,
+                self._B,
+                torque_limit_Nm=config.torque_limit_Nm,
+                torque_weight=config.torque_weight,
+                wrench_weight=config.wrench_weight,
+                acceleration_weight=config.acceleration_weight,
+                fixed_tasks=[cop_centering_task(layout, contacts, config.cop_centering_weight)],
+                solver=config.qp_solver,
+            )
+        return self._programs[active]
+
+    def _joint_limit_bounds(self, terms: RobotTerms) -> tuple[np.ndarray, np.ndarray]:
+        """vdot bounds: the limited joints' limit bounds, +-inf elsewhere."""
+        joints = self._joints
+        limited = joints.limited
+        lower, upper = joint_limit_acceleration_bounds(
+            terms.q[joints.q_indices[limited]],
+            terms.v[joints.v_indices[limited]],
+            joints.q_min[limited],
+            joints.q_max[limited],
+            self._config.joint_limit_horizon_s,
+        )
+        vdot_min = np.full(self._nv, -np.inf)
+        vdot_max = np.full(self._nv, np.inf)
+        vdot_min[joints.v_indices[limited]] = lower
+        vdot_max[joints.v_indices[limited]] = upper
+        return vdot_min, vdot_max
+
+    def _posture_tasks(
+        self, context: Context, terms: RobotTerms, standup_state: int, program: WholeBodyQp
+    ):
+        """Posture and base-orientation tasks; the posture state after this tick.
+
+        qddot* = -K_P (q - q_ref) - K_D qdot, q_ref low-pass filtered toward the state's
+        table (joints not in it: the posture latched at the first tick); the base is held
+        at the yaw of the first tick, pitched forward by the state's base pitch.
+        """
+        config, nu, joints = self._config, self._nu, self._joints
+        posture = context.get_discrete_state(self._posture).value()
+        q_joints = terms.q[joints.q_indices]
+        if posture[0] > 0.5:
+            q_initial, q_reference = posture[1 : 1 + nu], posture[1 + nu : 1 + 2 * nu]
+            base_yaw = posture[-1]
+        else:
+            q_initial, q_reference = q_joints, q_joints
+            base_yaw = math.atan2(terms.R_WB[1, 0], terms.R_WB[0, 0])
+        table = self._posture_tables[standup_state]
+        margin = config.posture_limit_margin_rad
+        q_target = np.clip(
+            np.where(np.isnan(table), q_initial, table),
+            joints.q_min + margin,
+            joints.q_max - margin,
+        )
+        kp_q = config.posture_kp_per_s2
+        kd_q = 2.0 * config.posture_damping_ratio * math.sqrt(kp_q)
+        qddot_star = -kp_q * (q_joints - q_reference) - kd_q * terms.v[joints.v_indices]
+        blend = min(self._period_s / config.posture_filter_time_constant_s, 1.0)
+        next_posture = np.concatenate(
+            [[1.0], q_initial, q_reference + blend * (q_target - q_reference), [base_yaw]]
+        )
+        kp_b = config.base_orientation_kp_per_s2
+        # root_link's x axis points backwards: a forward pitch is about its -y.
+        pitch = config.base_pitch_by_state_rad[standup_state - 1]
+        tasks = [
+            posture_task(program.layout, joints.v_indices, qddot_star, self._posture_weights),
+            base_orientation_task(
+                terms,
+                program.layout,
+                yaw_pitch_rotation(base_yaw, -pitch),
+                kp_b,
+                2.0 * config.base_orientation_damping_ratio * math.sqrt(kp_b),
+                config.base_orientation_weight,
+            ),
+        ]
+        return next_posture, tasks
+
+    def _contact_commands(
+        self, contacts: list[ContactSpec], standup_state: int, scales: dict[str, float]
+    ) -> list[ContactCommand]:
+        """Normal-force bounds from the plan: seat and thighs in seat_scale * [f_min,
+        f_max_seat], soles in [feet_scale * f_min, f_max_foot]. The seat holds all six
+        rows until seat_hinge_from_state, then all but the pitch about the hip axis."""
+        config = self._config
+        commands = []
+        for spec in contacts:
+            scale = scales[spec.frame]
+            held_rows = np.ones(WRENCH_SIZE, dtype=bool)
+            if spec.frame in ("l_sole", "r_sole"):
+                max_normal_force_N = config.foot_max_normal_force_N
+            else:
+                max_normal_force_N = scale * config.seat_max_normal_force_N
+                held_rows[1] = standup_state < config.seat_hinge_from_state  # alpha_y in C
+            commands.append(
+                ContactCommand(scale * config.min_normal_force_N, max_normal_force_N, held_rows)
+            )
+        return commands
+
+    def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
+        t_start = time.perf_counter()
+        tick = self.CalcTick(context)
+        solution = tick.solution
+        previous = context.get_discrete_state(self._diagnostics).value()
+        failures = previous[1] + (0.0 if solution.ok else 1.0)
+        if solution.ok:  # on failure the last torques stay in the actuation state
+            discrete_state.get_mutable_vector(self._actuation).SetFromVector(solution.tau)
+        integral = context.get_discrete_state(self._momentum_integral).value()
+        discrete_state.get_mutable_vector(self._momentum_integral).SetFromVector(
+            integral + self._period_s * tick.terms.L_WCom[:3]
+        )
+        discrete_state.get_mutable_vector(self._posture).SetFromVector(tick.posture)
+        total_s = time.perf_counter() - t_start
+        normal_forces = tick.normal_forces_N if solution.ok else np.full(len(self.CONTACTS), np.nan)
+        discrete_state.get_mutable_vector(self._diagnostics).SetFromVector(
+            np.concatenate(
+                [
+                    [float(solution.ok), failures, solution.solve_s, total_s],
+                    normal_forces,
+                    [np.linalg.norm(tick.helpful_force_W)],
+                ]
+            )
+        )
+        self._timing.append(
+            (tick.inputs_s, tick.kinematics_s, tick.assembly_s, solution.solve_s, total_s)
+        )

@@ -1,0 +1,376 @@
+"""The whole-body controller (drake_standup.controller, drake_standup/control/).
+
+Every check recomputes its reference from Drake's own functions (CalcMassMatrix,
+CalcBiasTerm, CalcGravityGeneralizedForces, CalcJacobianSpatialVelocity, the CoM and
+momentum functions), frame poses and the joints' damping, independently of the
+controller's code; a second QP solver checks the first.
+"""
+
+import numpy as np
+import pytest
+from pydrake.common.yaml import yaml_load_typed
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.tree import JacobianWrtVariable
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from drake_standup.config import Scenario
+from drake_standup.control.tasks import helpful_force
+from drake_standup.control.terms import RobotKinematics
+from drake_standup.controller import ControllerConfig, WholeBodyController
+from drake_standup.scene import add_scene, set_seated_state
+
+G = 9.81
+N_SAMPLES = 12
+
+
+@pytest.fixture(scope="module")
+def scene():
+    """The default scenario's plant (no seat hold) and its seated state x0."""
+    scenario = Scenario()
+    builder = DiagramBuilder()
+    scene = add_scene(builder, scenario, pd_gains=None, visuals=False)
+    context = scene.plant.CreateDefaultContext()
+    set_seated_state(scene, context, scenario)
+    x0 = scene.plant.GetPositionsAndVelocities(context, scene.robot.model_instance)
+    return scene, x0
+
+
+def _controller(scene, **config):
+    plant, robot = scene.plant, scene.robot
+    controller = WholeBodyController(plant, robot, ControllerConfig(**config))
+    return controller, controller.CreateDefaultContext()
+
+
+NO_PULL = np.zeros(12)
+
+
+def _fix_inputs(controller, context, x, com_reference, plan, hand_wrenches=NO_PULL):
+    controller.GetInputPort("robot_state").FixValue(context, x)
+    controller.GetInputPort("com_reference").FixValue(context, com_reference)
+    controller.GetInputPort("contact_plan").FixValue(context, plan)
+    controller.GetInputPort("hand_wrenches_W").FixValue(context, hand_wrenches)
+
+
+def _com(plant, instance, x):
+    context = plant.CreateDefaultContext()
+    plant.SetPositionsAndVelocities(context, instance, x)
+    return plant.CalcCenterOfMassPositionInWorld(context, [instance])
+
+
+def _random_state(plant, instance, x0, rng):
+    """Seated joint angles +-0.3 rad (within limits), a random base pose, random rates."""
+    context = plant.CreateDefaultContext()
+    plant.SetPositionsAndVelocities(context, instance, x0)
+    for index in plant.GetJointIndices(instance):
+        joint = plant.get_joint(index)
+        if joint.num_positions() == 1:
+            q = joint.GetOnePosition(context) + rng.uniform(-0.3, 0.3)
+            lower, upper = joint.position_lower_limits()[0], joint.position_upper_limits()[0]
+            joint.set_angle(context, float(np.clip(q, lower, upper)))
+    R = RotationMatrix(
+        np.linalg.qr(rng.normal(size=(3, 3)))[0] * np.sign(np.linalg.det(rng.normal(size=(3, 3))))
+    )
+    if np.linalg.det(R.matrix()) < 0:
+        R = RotationMatrix(-R.matrix())
+    base = plant.GetBodyByName("root_link", instance)
+    plant.SetFreeBodyPose(context, base, RigidTransform(R, rng.uniform(-1.0, 1.0, 3)))
+    plant.SetVelocities(context, instance, rng.normal(scale=0.3, size=plant.num_velocities()))
+    return plant.GetPositionsAndVelocities(context, instance)
+
+
+def _joint_damping(plant, instance):
+    D = np.zeros(plant.num_velocities())
+    for index in plant.GetJointIndices(instance):
+        joint = plant.get_joint(index)
+        D[joint.velocity_start() : joint.velocity_start() + joint.num_velocities()] = (
+            joint.default_damping_vector()
+        )
+    return D
+
+
+# --- (a) the solution obeys the floating-base dynamics and the contact limits -----------
+
+
+@pytest.mark.parametrize("standup_state", [1, 2], ids=["seat_held", "seat_hinged"])
+def test_solution_satisfies_dynamics_and_contact_limits(scene, standup_state):
+    """On random states, with seat, thighs and soles in contact and random hand wrenches:
+
+        M vdot + C v - tau_g + D v = B tau + sum_c J_c^T F_c + sum_h J_h^T F_h   (1e-6)
+
+    with Drake's M, Cv, tau_g, Jacobians (D: the joints' damping, which the plant
+    applies); each contact wrench in its frame obeys the friction pyramid (mu 1/3),
+    torsion (1/75), CoP box and normal-force bounds; |tau| <= 60 N m."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    config = ControllerConfig()
+    controller, context = _controller(scene)
+    specs = {spec.frame: spec for spec in controller.contact_specs}
+    B = plant.MakeActuationMatrix()
+    D = _joint_damping(plant, instance)
+    world = plant.world_frame()
+    rng = np.random.default_rng(standup_state)
+    plant_context = plant.CreateDefaultContext()
+
+    def jacobian(frame_name):
+        frame = robot.frame(plant, frame_name)
+        return plant.CalcJacobianSpatialVelocity(
+            plant_context, JacobianWrtVariable.kV, frame, np.zeros(3), world, world
+        )
+
+    for _ in range(N_SAMPLES):
+        x = _random_state(plant, instance, x0, rng)
+        hands = np.concatenate([rng.normal(scale=[2, 2, 2, 20, 20, 20]) for _ in range(2)])
+        com = _com(plant, instance, x)
+        reference = np.concatenate([com + rng.normal(scale=0.02, size=3), np.zeros(6)])
+        _fix_inputs(controller, context, x, reference, [standup_state, 1.0, 1.0], hands)
+        solution = controller.CalcTick(context).solution
+        assert solution.ok
+        assert sorted(solution.frames) == sorted(WholeBodyController.CONTACTS)
+
+        plant.SetPositionsAndVelocities(plant_context, instance, x)
+        v = x[plant.num_positions() :]
+        lhs = (
+            plant.CalcMassMatrix(plant_context) @ solution.vdot
+            + plant.CalcBiasTerm(plant_context)
+            - plant.CalcGravityGeneralizedForces(plant_context)
+            + D * v
+        )
+        rhs = B @ solution.tau
+        rhs += sum(jacobian(f).T @ F for f, F in zip(solution.frames, solution.F_W, strict=True))
+        rhs += jacobian("l_hand").T @ hands[:6] + jacobian("r_hand").T @ hands[6:]
+        np.testing.assert_allclose(lhs, rhs, atol=1e-6 * max(1.0, np.abs(lhs).max()))
+
+        assert np.abs(solution.tau).max() <= config.torque_limit_Nm + 1e-6
+        for frame_name, F_W in zip(solution.frames, solution.F_W, strict=True):
+            R_WC = robot.frame(plant, frame_name).CalcPoseInWorld(plant_context).rotation()
+            tau_C = R_WC.inverse() @ F_W[:3]
+            f_C = R_WC.inverse() @ F_W[3:]
+            spec, fz, tol = specs[frame_name], f_C[2], 1e-5
+            assert fz >= config.min_normal_force_N - tol
+            assert fz <= (
+                config.foot_max_normal_force_N
+                if "sole" in frame_name
+                else config.seat_max_normal_force_N
+            )
+            mu = config.friction_coefficient
+            assert abs(f_C[0]) <= mu * fz + tol and abs(f_C[1]) <= mu * fz + tol
+            if spec.point:  # thighs: a force at the pad's centre
+                np.testing.assert_allclose(tau_C, 0.0, atol=1e-12)
+                continue
+            assert abs(tau_C[2]) <= config.torsional_friction_coefficient_m * fz + tol
+            cop_x, cop_y = -tau_C[1] / fz, tau_C[0] / fz
+            assert spec.cop_x_m[0] - tol <= cop_x <= spec.cop_x_m[1] + tol
+            assert spec.cop_y_m[0] - tol <= cop_y <= spec.cop_y_m[1] + tol
+
+
+def test_cop_boxes_lie_on_their_pads(scene):
+    """The seat's CoP box lies on the buttocks pad and each sole's on its sole pad, at
+    least 5 mm inside (pad boxes from models/icub_contact.yaml, seated pose)."""
+    import yaml
+
+    from drake_standup.robot import CONTACT_FILE
+
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    context = plant.CreateDefaultContext()
+    plant.SetPositionsAndVelocities(context, robot.model_instance, x0)
+    pads = {shape["name"]: shape for shape in yaml.safe_load(CONTACT_FILE.read_text())["shapes"]}
+    controller, _ = _controller(scene)
+    pad_of = {"seat": "buttocks_pad", "l_sole": "l_sole_pad", "r_sole": "r_sole_pad"}
+    for spec in controller.contact_specs:
+        if spec.point:
+            continue
+        pad = pads[pad_of[spec.frame]]
+        X_WC = robot.frame(plant, spec.frame).CalcPoseInWorld(context)
+        X_WP = plant.GetFrameByName(pad["frame"], robot.model_instance).CalcPoseInWorld(
+            context
+        ) @ RigidTransform(pad["xyz_m"])
+        half = np.array(pad["size_m"][:2]) / 2
+        for x in spec.cop_x_m:
+            for y in spec.cop_y_m:
+                p_PCorner = X_WP.inverse() @ (X_WC @ np.array([x, y, 0.0]))
+                assert np.all(np.abs(p_PCorner[:2]) <= half - 0.005), (spec.frame, x, y)
+
+
+# --- (b) static seated balance ------------------------------------------------------------
+
+
+def test_static_seated_reference_balances_gravity(scene):
+    """Seated at rest, x_d = CoM, zero reference velocity and acceleration: the commanded
+    contact forces sum to m g (1 %) and their moments about the CoM cancel."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    controller, context = _controller(scene)
+    com = _com(plant, instance, x0)
+    _fix_inputs(controller, context, x0, np.concatenate([com, np.zeros(6)]), [1.0, 1.0, 1.0])
+    solution = controller.CalcTick(context).solution
+    assert solution.ok
+
+    plant_context = plant.CreateDefaultContext()
+    plant.SetPositionsAndVelocities(plant_context, instance, x0)
+    weight_N = plant.CalcTotalMass(plant_context, [instance]) * G
+    force = solution.F_W[:, 3:].sum(axis=0)
+    np.testing.assert_allclose(force, [0.0, 0.0, weight_N], atol=0.01 * weight_N)
+    moment = np.zeros(3)
+    for frame_name, F_W in zip(solution.frames, solution.F_W, strict=True):
+        p_WC = robot.frame(plant, frame_name).CalcPoseInWorld(plant_context).translation()
+        moment += F_W[:3] + np.cross(p_WC - com, F_W[3:])
+    np.testing.assert_allclose(moment, 0.0, atol=0.01 * weight_N * 0.1)  # 1 % of m g x 10 cm
+    # Every contact carries part of the load: the seat does not hang on the soles alone.
+    assert np.all(solution.F_C[:, 5] >= ControllerConfig().min_normal_force_N - 1e-6)
+
+
+# --- (c) the centroidal identities the controller relies on -------------------------------
+
+
+def test_com_jacobian_bias_and_momentum_from_the_mass_matrix(scene):
+    """With the floating-base velocities expressed in W (SPEC 5), on random states:
+    M[3:6]/m = J_com, Cv[3:6]/m = Jdot_com v, M[3:6]^T g = tau_g, and the controller's
+    centroidal momentum equals Drake's spatial momentum about the CoM."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    world = plant.world_frame()
+    context = plant.CreateDefaultContext()
+    kinematics = RobotKinematics(plant, robot, held_frames=[], other_frames=[])
+    mass = plant.CalcTotalMass(context, [instance])
+    rng = np.random.default_rng(3)
+    for _ in range(N_SAMPLES):
+        x = _random_state(plant, instance, x0, rng)
+        plant.SetPositionsAndVelocities(context, instance, x)
+        M = plant.CalcMassMatrix(context)
+        J_com = plant.CalcJacobianCenterOfMassTranslationalVelocity(
+            context, [instance], JacobianWrtVariable.kV, world, world
+        )
+        np.testing.assert_allclose(M[3:6] / mass, J_com, atol=1e-10)
+        bias = plant.CalcBiasCenterOfMassTranslationalAcceleration(
+            context, [instance], JacobianWrtVariable.kV, world, world
+        )
+        np.testing.assert_allclose(plant.CalcBiasTerm(context)[3:6] / mass, bias, atol=1e-9)
+        g_W = plant.gravity_field().gravity_vector()
+        np.testing.assert_allclose(
+            M[3:6].T @ g_W, plant.CalcGravityGeneralizedForces(context), atol=1e-9
+        )
+        terms = kinematics.calc(x, [])
+        p_WCom = plant.CalcCenterOfMassPositionInWorld(context, [instance])
+        L = plant.CalcSpatialMomentumInWorldAboutPoint(context, [instance], p_WCom)
+        np.testing.assert_allclose(terms.p_WCom, p_WCom, atol=1e-12)
+        np.testing.assert_allclose(terms.L_WCom[:3], L.rotational(), atol=1e-9)
+        np.testing.assert_allclose(terms.L_WCom[3:], L.translational(), atol=1e-9)
+        np.testing.assert_allclose(terms.v_WCom, J_com @ x[plant.num_positions() :], atol=1e-9)
+
+
+# --- The human's help ------------------------------------------------------------------------
+
+
+def test_helpful_force_passes_only_the_helpful_part():
+    """f_par: the component along xd_dot when it points along it; nothing against it,
+    nothing at rest, full at speed, nothing once the CoM leads its reference by lead_max."""
+    xd_dot = np.array([0.2, 0.0, 0.0])
+    f_hand = np.array([15.0, 5.0, 30.0])
+    np.testing.assert_allclose(helpful_force(f_hand, xd_dot, 0.0, 0.02, 0.02), [15.0, 0, 0])
+    np.testing.assert_allclose(helpful_force(-f_hand, xd_dot, 0.0, 0.02, 0.02), 0.0)
+    np.testing.assert_allclose(helpful_force(f_hand, np.zeros(3), 0.0, 0.02, 0.02), 0.0)
+    np.testing.assert_allclose(helpful_force(f_hand, xd_dot, 0.02, 0.02, 0.02), 0.0)
+    slow = helpful_force(f_hand, xd_dot * 0.05, 0.0, 0.02, 0.02)  # 1 cm/s: half faded
+    assert 0.0 < slow[0] < 15.0 and slow[1] == slow[2] == 0.0
+
+
+@pytest.mark.parametrize("moving", [False, True], ids=["at_rest", "moving_forward"])
+def test_contacts_cancel_all_but_the_helpful_pull(scene, moving):
+    """Seated at rest with x_d = CoM and a 15 N forward + 15 N up pull on each hand:
+    with xd_dot = 0 the contacts cancel the whole pull (sum F_c + f_hand + m g = 0);
+    with xd_dot along +x they leave the forward 30 N acting (sum F_c,x = m xddot*_x)
+    and cancel the rest. (A momentum weight of 1e4 makes the momentum task all but hard:
+    at the default weight the posture task takes ~1 N of it here.)"""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    config = ControllerConfig()
+    controller, context = _controller(scene, momentum_weight=1e4)
+    com = _com(plant, instance, x0)
+    xd_dot = np.array([0.1, 0.0, 0.0]) if moving else np.zeros(3)
+    hands = np.tile([0.0, 0.0, 0.0, 15.0, 0.0, 15.0], 2)
+    _fix_inputs(
+        controller, context, x0, np.concatenate([com, xd_dot, np.zeros(3)]), [2, 1, 1], hands
+    )
+    solution = controller.CalcTick(context).solution
+    assert solution.ok
+    mass = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
+    kd_x = 2.0 * config.com_damping_ratio * np.sqrt(config.com_kp_seated_per_s2[0])
+    xddot_x = kd_x * xd_dot[0]  # xddot* = xd_ddot - K_D (0 - xd_dot) - K_P 0
+    contacts = solution.F_W[:, 3:].sum(axis=0)
+    expected = np.array([mass * xddot_x - (0.0 if moving else 30.0), 0.0, mass * G - 30.0])
+    np.testing.assert_allclose(contacts, expected, atol=0.5)
+
+
+# --- Failure handling, solvers, interface ----------------------------------------------------
+
+
+def test_failed_qp_keeps_last_torques_and_counts(scene):
+    """An infeasible QP (minimum normal force above the seat's maximum) neither raises
+    nor changes the actuation; qp_ok drops to 0 and the failure count rises."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    controller, context = _controller(scene, min_normal_force_N=500.0)
+    com = _com(plant, robot.model_instance, x0)
+    _fix_inputs(controller, context, x0, np.concatenate([com, np.zeros(6)]), [1, 1, 1])
+    last = np.linspace(-1.0, 1.0, plant.num_actuators())
+    context.get_mutable_discrete_state(0).SetFromVector(last)
+    simulator = Simulator(controller, context)
+    simulator.Initialize()  # the initialization update
+    simulator.AdvanceTo(0.0025)  # periodic updates at 0, 1 and 2 ms
+    actuation = controller.GetOutputPort("actuation").Eval(context)
+    np.testing.assert_array_equal(actuation, last)
+    diagnostics = controller.GetOutputPort("diagnostics").Eval(context)
+    diagnostics = dict(zip(controller.DIAGNOSTICS, diagnostics, strict=True))
+    assert diagnostics["qp_ok"] == 0.0 and diagnostics["qp_failures"] == 4.0
+
+
+@pytest.mark.parametrize("solver", ["clarabel", "osqp"])
+def test_drake_solvers_agree_with_daqp(scene, solver):
+    """The same tick on a random state, solved by daqp and by Drake's Clarabel / OSQP:
+    the same torques and contact wrenches."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    x = _random_state(plant, instance, x0, np.random.default_rng(8))
+    com = _com(plant, instance, x)
+    solutions = []
+    for name in ("daqp", solver):
+        controller, context = _controller(scene, qp_solver=name)
+        _fix_inputs(controller, context, x, np.concatenate([com, np.zeros(6)]), [2, 1, 1])
+        solutions.append(controller.CalcTick(context).solution)
+    reference, other = solutions
+    assert reference.ok and other.ok
+    np.testing.assert_allclose(other.tau, reference.tau, atol=0.05)  # OSQP: first-order
+    np.testing.assert_allclose(other.F_W, reference.F_W, atol=1e-1)
+
+
+def test_ports_and_config(scene):
+    """Port names and sizes the diagram relies on; the config loads from YAML typed."""
+    scene, _ = scene
+    controller, _ = _controller(scene)
+    plant = scene.plant
+    sizes = {
+        "robot_state": plant.num_positions() + plant.num_velocities(),
+        "com_reference": 9,
+        "contact_plan": 3,
+        "hand_wrenches_W": 12,
+    }
+    for name, size in sizes.items():
+        assert controller.GetInputPort(name).size() == size
+    assert controller.GetOutputPort("actuation").size() == plant.num_actuators()
+    assert controller.GetOutputPort("diagnostics").size() == len(controller.DIAGNOSTICS)
+    config = yaml_load_typed(
+        schema=ControllerConfig, data="qp_solver: clarabel\ncom_kp_seated_per_s2: [1, 2, 3]\n"
+    )
+    assert config.qp_solver == "clarabel" and config.com_kp_seated_per_s2 == [1.0, 2.0, 3.0]
+    assert config.posture_state4_rad == ControllerConfig().posture_state4_rad
+    with pytest.raises(ValueError, match="qp_solver"):
+        _controller(scene, qp_solver="cplex")
+    with pytest.raises(ValueError, match="posture_state2_rad"):
+        _controller(scene, posture_state2_rad={"no_such_joint": 0.0})
