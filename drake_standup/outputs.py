@@ -124,7 +124,9 @@ def _plt():
 def _mark_states(ax, entry_times_s, label: bool = False) -> None:
     for k, t in enumerate(entry_times_s[1:], start=2):
         if t is not None and np.isfinite(t):
-            ax.axvline(t, color=STATE_COLORS[k], ls=":", lw=1.2, label=f"state {k}" if label else None)
+            ax.axvline(
+                t, color=STATE_COLORS[k], ls=":", lw=1.2, label=f"state {k}" if label else None
+            )
 
 
 def figure_advancement(signals: dict, baseline: dict | None, entry_times_s, path: Path) -> None:
