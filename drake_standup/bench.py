@@ -15,14 +15,14 @@ import sys
 import time
 from pathlib import Path
 
-from drake_standup.config import ScenarioError, load_scenario
+from drake_standup.config import SCENARIO_DIR, ScenarioError, load_scenario
 from drake_standup.simulate import simulate
 
 
-def _rates(scenario, repeat: int, record: bool) -> dict:
+def _rates(scenario, repeat: int, record: bool, controller: str) -> dict:
     rates, build = [], []
     for _ in range(repeat):
-        result = simulate(scenario, None, record=record, progress=False)
+        result = simulate(scenario, None, record=record, progress=False, controller=controller)
         rates.append(result.metrics["realtime_factor"])
         build.append(result.metrics["build_time_s"])
     return {
@@ -38,7 +38,7 @@ def _rates(scenario, repeat: int, record: bool) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--scenario", type=Path, default=None)
+    parser.add_argument("--scenario", type=Path, default=SCENARIO_DIR / "seated.yaml")
     parser.add_argument("--duration", type=float, default=3.0, help="simulated s per repetition")
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args(argv)
@@ -50,11 +50,19 @@ def main(argv: list[str] | None = None) -> int:
     scenario.duration_s = args.duration
 
     t0 = time.perf_counter()
+    plant_only = _rates(scenario, args.repeat, record=False, controller="seat_hold")
+    closed_loop = _rates(scenario, args.repeat, record=False, controller="whole_body")
     summary = {
-        "scenario": str(args.scenario or "default"),
+        "scenario": str(args.scenario),
         "duration_s": args.duration,
-        "seated_hold_plant_pd": _rates(scenario, args.repeat, record=False),
-        "seated_hold_plant_pd_recording": _rates(scenario, args.repeat, record=True),
+        "seat_hold_plant_pd": plant_only,
+        "seat_hold_plant_pd_recording": _rates(
+            scenario, args.repeat, record=True, controller="seat_hold"
+        ),
+        "whole_body_controller": closed_loop,
+        "ratio_closed_loop_to_plant_only": (
+            closed_loop["sim_s_per_wall_s"]["median"] / plant_only["sim_s_per_wall_s"]["median"]
+        ),
         "bench_wall_s": None,
     }
     summary["bench_wall_s"] = time.perf_counter() - t0

@@ -228,8 +228,8 @@ class VisualizationConfig:
     # Meshcat recording frame period; 30 fps keeps a 15 s HTML small. s.
     publish_period_s: float = 1.0 / 30.0
     # Camera position and target that frame the robot on its chair. m.
-    camera_xyz_m: list[float] = field(default_factory=lambda: [0.85, -0.8, 0.65])
-    target_xyz_m: list[float] = field(default_factory=lambda: [0.1, 0.0, 0.35])
+    camera_xyz_m: list[float] = field(default_factory=lambda: [1.05, -1.0, 0.8])
+    target_xyz_m: list[float] = field(default_factory=lambda: [0.15, 0.0, 0.42])
     show_contact_forces: bool = True
     # Contact force arrows at 10 Hz: enough to read, and they cost the HTML
     # ~0.13 MB per simulated second at 30 Hz. s.

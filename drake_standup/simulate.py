@@ -62,6 +62,7 @@ def simulate(
     record: bool = True,
     progress: bool = True,
     baseline: bool = False,
+    controller: str = "whole_body",
     chunk_s: float = 0.05,
 ) -> RunResult:
     """Simulates scenario; writes recording, metrics, figures and diagram into out_dir.
@@ -70,6 +71,7 @@ def simulate(
     for the faded reference of figure_advancement.png and the metric
     standup_time_s_without_advancement. Where nothing could advance psi (no
     human, or advancement already off) the run is its own baseline.
+    controller: 'whole_body', or 'seat_hold' (the plant-only benchmark).
     """
     base = None
     if baseline and scenario.advancement.enabled and _human_acts(scenario):
@@ -82,6 +84,7 @@ def simulate(
             progress=progress,
             chunk_s=chunk_s,
             label="baseline (psi = t)",
+            controller=controller,
         )
     result = _simulate_one(
         scenario,
@@ -91,6 +94,7 @@ def simulate(
         chunk_s=chunk_s,
         label="simulating",
         baseline=base,
+        controller=controller,
     )
     return result
 
@@ -107,11 +111,12 @@ def _simulate_one(
     progress: bool,
     chunk_s: float,
     label: str,
+    controller: str,
     baseline: RunResult | None = None,
 ) -> RunResult:
     meshcat = make_meshcat() if record else None
     t_build = time.perf_counter()
-    built = build_diagram(scenario, meshcat)
+    built = build_diagram(scenario, meshcat, controller)
     build_time_s = time.perf_counter() - t_build
 
     simulator = Simulator(built.diagram)
