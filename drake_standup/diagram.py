@@ -55,9 +55,8 @@ def build_diagram(
     if controller not in CONTROLLERS:
         raise ValueError(f"controller: '{controller}'; accepted: {', '.join(CONTROLLERS)}")
     builder = DiagramBuilder()
-    # Every iCub model of icub-models names its revolute joints alike; the
-    # seat hold gives them all the same gains.
-    pd_gains = _AllJoints(scenario) if controller == "seat_hold" else None
+    hold = scenario.seat_hold
+    pd_gains = (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad) if controller == "seat_hold" else None
     scene = add_scene(builder, scenario, pd_gains=pd_gains)
     plant = scene.plant
     instance = scene.robot.model_instance
@@ -197,17 +196,6 @@ def _add_seat_hold(builder: DiagramBuilder, scene: Scene, scenario: Scenario) ->
     feedforward = builder.AddNamedSystem("seat_hold_feedforward", ConstantVectorSource(u_ff))
     builder.Connect(setpoint.get_output_port(), plant.get_desired_state_input_port(instance))
     builder.Connect(feedforward.get_output_port(), plant.get_actuation_input_port(instance))
-
-
-class _AllJoints(dict):
-    """Gains map that answers every joint name with the seat-hold gains."""
-
-    def __init__(self, scenario: Scenario):
-        super().__init__()
-        self._gains = (scenario.seat_hold.kp_Nm_per_rad, scenario.seat_hold.kd_Nms_per_rad)
-
-    def __getitem__(self, name: str) -> tuple[float, float]:
-        return self._gains
 
 
 def _actuated_position_selector(plant, instance) -> np.ndarray:

@@ -58,6 +58,18 @@ def export_diagram(diagram: Diagram, directory: Path, stem: str = "standup") -> 
     return written
 
 
+def group_normal_forces(pad_forces_W: np.ndarray, pad_groups: dict[str, str]) -> dict:
+    """Group name -> summed normal (z) force of its pads over time, (N,) each.
+
+    pad_forces_W is (n_pads, 3, N) with rows in the order of pad_groups.
+    """
+    groups = list(pad_groups.values())
+    return {
+        group: pad_forces_W[[i for i, g in enumerate(groups) if g == group], 2].sum(axis=0)
+        for group in dict.fromkeys(groups)
+    }
+
+
 def seated_metrics(
     times_s: np.ndarray,
     com_W: np.ndarray,
@@ -84,11 +96,8 @@ def seated_metrics(
     if pad_forces_W.shape[-1] > 0:
         final = pad_forces_W[:, :, -1]
         metrics["contact_force_N"] = {n: final[i] for i, n in enumerate(pad_names)}
-        by_group: dict[str, float] = {}
-        for i, name in enumerate(pad_names):
-            group = pad_groups[name]
-            by_group[group] = by_group.get(group, 0.0) + float(final[i, 2])
-        metrics["contact_normal_force_N"] = by_group
+        by_group = group_normal_forces(pad_forces_W, pad_groups)
+        metrics["contact_normal_force_N"] = {g: float(fz[-1]) for g, fz in by_group.items()}
         metrics["contact_force_total_N"] = final.sum(axis=0)
     return metrics
 
@@ -192,10 +201,8 @@ def figure_tracking(signals: dict, pad_groups: dict[str, str], entry_times_s, pa
         ax.set_ylabel(f"CoM {name} [m]")
         ax.legend(fontsize=8)
     t, pads = signals["pad_forces_W"]
-    pads = pads.reshape(len(pad_groups), 3, -1)
-    for group in dict.fromkeys(pad_groups.values()):
-        rows = [i for i, g in enumerate(pad_groups.values()) if g == group]
-        ax_f.plot(t, pads[rows, 2].sum(axis=0), label=group)
+    for group, fz in group_normal_forces(pads.reshape(len(pad_groups), 3, -1), pad_groups).items():
+        ax_f.plot(t, fz, label=group)
     ax_f.set_ylabel("normal force [N]")
     ax_f.set_xlabel("time [s]")
     ax_f.legend(fontsize=8)

@@ -297,14 +297,14 @@ def add_icub(
     reduce: bool = True,
     visuals: bool = True,
     effort_limit_Nm: float = 60.0,
-    pd_gains: dict[str, tuple[float, float]] | None = None,
+    pd_gains: tuple[float, float] | None = None,
     contact: ContactModel | None = None,
     visual_max_faces: int = 1000,
 ) -> Robot:
     """Adds the iCub to plant (before Finalize) and returns its handles.
 
-    pd_gains maps joint name -> (Kp [N m/rad], Kd [N m s/rad]) for Drake's
-    built-in implicit joint PD; None leaves the actuators pure torque sources.
+    pd_gains (Kp [N m/rad], Kd [N m s/rad]) gives every joint Drake's built-in
+    implicit joint PD; None leaves the actuators pure torque sources.
     """
     prepared = prepare_urdf(
         model_name, reduce=reduce, visuals=visuals, visual_max_faces=visual_max_faces
@@ -331,7 +331,7 @@ def add_icub(
             joint_names.append(joint.name())
             actuator = plant.AddJointActuator(joint.name(), joint, effort_limit_Nm)
             if pd_gains is not None:
-                kp, kd = pd_gains[joint.name()]
+                kp, kd = pd_gains
                 actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))
 
     groups: dict[str, list[str]] = {}

@@ -28,7 +28,7 @@ def add_scene(
     builder: DiagramBuilder,
     scenario: Scenario,
     *,
-    pd_gains: dict[str, tuple[float, float]] | None = None,
+    pd_gains: tuple[float, float] | None = None,
     visuals: bool = True,
 ) -> Scene:
     """Adds plant and scene graph to builder; returns the finalized scene."""
