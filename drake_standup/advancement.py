@@ -28,6 +28,7 @@ import math
 import numpy as np
 from pydrake.systems.framework import BasicVector, Context, ContinuousState, LeafSystem
 
+from drake_standup.caching import declare_cached
 from drake_standup.config import AdvancementConfig
 
 
@@ -91,11 +92,26 @@ class TrajectoryAdvancement(LeafSystem):
             self._CalcPsi,
             prerequisites_of_calc={self.all_state_ticket()},
         )
-        self.DeclareVectorOutputPort("psi_dot", 1, self._CalcPsiDot)
-        self.DeclareVectorOutputPort("psi_ddot", 1, self._CalcPsiDdot)
-        self.DeclareVectorOutputPort("alpha", 1, self._CalcAlpha)
+        # The law reads the inputs only: evaluated once per change of them,
+        # however many outputs and integrator stages ask.
+        inputs = {
+            port.ticket() for port in (self._com, self._v, self._omega_f, self._x_d, self._tangent)
+        }
+        self._law_cache = declare_cached(self, "psi_dot law", self._calc_law, inputs)
+        law = {self._law_cache.ticket()}
+        self.DeclareVectorOutputPort("psi_dot", 1, self._CalcPsiDot, prerequisites_of_calc=law)
+        self.DeclareVectorOutputPort(
+            "psi_ddot",
+            1,
+            self._CalcPsiDdot,
+            prerequisites_of_calc=law | {self.all_state_ticket()},
+        )
+        self.DeclareVectorOutputPort("alpha", 1, self._CalcAlpha, prerequisites_of_calc=law)
 
     def _law(self, context: Context) -> tuple[float, float]:
+        return self._law_cache.Eval(context)
+
+    def _calc_law(self, context: Context) -> tuple[float, float]:
         tangent = self._tangent.Eval(context)
         return psi_dot_law(
             self._config,

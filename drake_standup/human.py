@@ -15,6 +15,7 @@ from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
+from drake_standup.caching import declare_cached
 from drake_standup.config import HumanConfig, Pull, ReactiveHumanConfig
 from drake_standup.robot import Robot
 
@@ -75,8 +76,14 @@ class HumanWrenchSource(LeafSystem):
         self._instance = robot.model_instance
         self._context = plant.CreateDefaultContext()
         self._frames = [robot.frame(plant, name) for name in TASK_FRAMES]
-        self._bodies = [frame.body() for frame in self._frames]
-        self._p_BoFo_B = [frame.GetFixedPoseInBodyFrame().translation() for frame in self._frames]
+        # One applied force per hand, at the hand frame's origin; each tick
+        # sets its force only.
+        self._applied = []
+        for frame in self._frames:
+            applied = ExternallyAppliedSpatialForce()
+            applied.body_index = frame.body().index()
+            applied.p_BoBq_B = frame.GetFixedPoseInBodyFrame().translation()
+            self._applied.append(applied)
         nx = plant.num_multibody_states(self._instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         prereq = {self.time_ticket()}
@@ -86,6 +93,9 @@ class HumanWrenchSource(LeafSystem):
             self._start_index = self.DeclareDiscreteState(6)
             self.DeclareInitializationDiscreteUpdateEvent(self._CaptureStart)
             prereq |= {self._state.ticket(), self.all_state_ticket()}
+        # Both outputs read one evaluation of the human per time (and state).
+        self._forces_cache = declare_cached(self, "hand forces", self._forces, prereq)
+        prereq = {self._forces_cache.ticket()}
         self.DeclareVectorOutputPort(
             "hand_wrenches_W", 12, self._CalcWrenches, prerequisites_of_calc=prereq
         )
@@ -123,15 +133,15 @@ class HumanWrenchSource(LeafSystem):
         )
 
     def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
-        f = self._forces(context)
+        f = self._forces_cache.Eval(context)
         output.SetFromVector(np.concatenate([np.zeros(3), f[0], np.zeros(3), f[1]]))
 
     def _CalcSpatialForces(self, context: Context, output) -> None:
+        """One force per pulled hand (none while nobody pulls: the plant then
+        has nothing to apply)."""
         forces = []
-        for body, p_BoFo_B, f in zip(self._bodies, self._p_BoFo_B, self._forces(context)):
-            applied = ExternallyAppliedSpatialForce()
-            applied.body_index = body.index()
-            applied.p_BoBq_B = p_BoFo_B
-            applied.F_Bq_W = SpatialForce(np.zeros(3), f)
-            forces.append(applied)
+        for applied, f in zip(self._applied, self._forces_cache.Eval(context)):
+            if f.any():
+                applied.F_Bq_W = SpatialForce(np.zeros(3), f)
+                forces.append(applied)
         output.set_value(forces)

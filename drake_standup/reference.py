@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
+from drake_standup.caching import declare_cached
+
 SEGMENT_SIZE = 8  # [psi_entry, T, x_start (3), delta (3)]
 
 
@@ -54,8 +56,21 @@ class CoMReferenceGenerator(LeafSystem):
         self._psi_dot = self.DeclareVectorInputPort("psi_dot", 1)
         self._psi_ddot = self.DeclareVectorInputPort("psi_ddot", 1)
         self._segment = self.DeclareVectorInputPort("segment", SEGMENT_SIZE)
-        self.DeclareVectorOutputPort("com_reference", 9, self._CalcReference)
-        path_only = {self._psi.ticket(), self._segment.ticket()}
+        # The path depends on psi and the segment only: evaluated once per
+        # change of them for all three outputs.
+        self._path = declare_cached(
+            self,
+            "path at psi",
+            lambda context: path(self._segment.Eval(context), self._psi.Eval(context)[0]),
+            {self._psi.ticket(), self._segment.ticket()},
+        )
+        path_only = {self._path.ticket()}
+        self.DeclareVectorOutputPort(
+            "com_reference",
+            9,
+            self._CalcReference,
+            prerequisites_of_calc=path_only | {self._psi_dot.ticket(), self._psi_ddot.ticket()},
+        )
         self.DeclareVectorOutputPort(
             "x_d_W", 3, self._CalcPosition, prerequisites_of_calc=path_only
         )
@@ -64,7 +79,7 @@ class CoMReferenceGenerator(LeafSystem):
         )
 
     def _CalcReference(self, context: Context, output: BasicVector) -> None:
-        x_d, d_x, dd_x = path(self._segment.Eval(context), self._psi.Eval(context)[0])
+        x_d, d_x, dd_x = self._path.Eval(context)
         psi_dot = self._psi_dot.Eval(context)[0]
         psi_ddot = self._psi_ddot.Eval(context)[0]
         output.SetFromVector(
@@ -72,9 +87,9 @@ class CoMReferenceGenerator(LeafSystem):
         )
 
     def _CalcPosition(self, context: Context, output: BasicVector) -> None:
-        x_d, _, _ = path(self._segment.Eval(context), self._psi.Eval(context)[0])
+        x_d = self._path.Eval(context)[0]
         output.SetFromVector(x_d)
 
     def _CalcTangent(self, context: Context, output: BasicVector) -> None:
-        _, d_x, _ = path(self._segment.Eval(context), self._psi.Eval(context)[0])
+        d_x = self._path.Eval(context)[1]
         output.SetFromVector(d_x)

@@ -3,6 +3,7 @@ and a floor, hydroelastic contact, and the robot's seated initial state."""
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, SceneGraph
@@ -15,6 +16,17 @@ from drake_standup.config import REPO_ROOT, Scenario, _resolve
 from drake_standup.robot import Robot, add_icub, set_joint_positions
 
 MODELS_DIR = REPO_ROOT / "models"
+
+
+class _NoDeformableHalfSpaceWarning(logging.Filter):
+    """Drake warns, for every rigid half-space, that deformable bodies cannot
+    touch it; the scene has no deformable bodies, so the warning says nothing."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return "half spaces are not currently supported for deformable" not in record.getMessage()
+
+
+logging.getLogger("drake").addFilter(_NoDeformableHalfSpaceWarning())
 
 
 @dataclass

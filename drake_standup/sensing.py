@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
+from drake_standup.caching import declare_cached
 from drake_standup.robot import Robot
 
 HANDS = ("l_hand", "r_hand")
@@ -33,6 +33,10 @@ class RobotSensing(LeafSystem):
     Outputs com_W (3, m), com_velocity_W (3, m/s), omega_f_W (3, m/s^2) and
     heel_x_W (1, m: the front-most of the two soles' heel edges, so "CoM ahead
     of the heels" holds for both feet).
+
+    The kinematic outputs share one cache entry that depends on robot_state
+    only: the plant context is set once per new state (once per plant step),
+    not once per output and integrator stage.
     """
 
     def __init__(self, plant: MultibodyPlant, robot: Robot, heel_points: dict[str, np.ndarray]):
@@ -40,66 +44,49 @@ class RobotSensing(LeafSystem):
         self._plant = plant
         self._instance = robot.model_instance
         self._context = plant.CreateDefaultContext()
-        self._hands = [robot.frame(plant, h) for h in HANDS]
+        self._mass_kg = plant.CalcTotalMass(self._context, [self._instance])
         self._heels = [(robot.frame(plant, s), np.asarray(p)) for s, p in heel_points.items()]
         nx = plant.num_multibody_states(self._instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         self._wrenches = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         state_only = {self._state.ticket()}
-        self.DeclareVectorOutputPort("com_W", 3, self._CalcCom, prerequisites_of_calc=state_only)
-        self.DeclareVectorOutputPort(
-            "com_velocity_W", 3, self._CalcComVelocity, prerequisites_of_calc=state_only
-        )
-        self.DeclareVectorOutputPort(
-            "omega_f_W",
-            3,
-            self._CalcOmegaF,
-            prerequisites_of_calc={self._state.ticket(), self._wrenches.ticket()},
-        )
-        self.DeclareVectorOutputPort(
-            "heel_x_W", 1, self._CalcHeelX, prerequisites_of_calc=state_only
-        )
-
-    def _sync(self, context: Context) -> Context:
-        x = self._state.Eval(context)
-        self._plant.SetPositionsAndVelocities(self._context, self._instance, x)
-        return self._context
-
-    def _CalcCom(self, context: Context, output: BasicVector) -> None:
-        c = self._sync(context)
-        output.SetFromVector(self._plant.CalcCenterOfMassPositionInWorld(c, [self._instance]))
-
-    def _CalcComVelocity(self, context: Context, output: BasicVector) -> None:
-        c = self._sync(context)
-        output.SetFromVector(
-            self._plant.CalcCenterOfMassTranslationalVelocityInWorld(c, [self._instance])
-        )
-
-    def _CalcOmegaF(self, context: Context, output: BasicVector) -> None:
-        """Omega f = J_com M^-1 sum_h J_h^T F_h (paper, Sec. II)."""
-        F = self._wrenches.Eval(context).reshape(2, 6)
-        if not F.any():
-            output.SetFromVector(np.zeros(3))
-            return
-        plant, c = self._plant, self._sync(context)
-        world = plant.world_frame()
-        tau = np.zeros(plant.num_velocities())
-        for frame, F_h in zip(self._hands, F):
-            J_h = plant.CalcJacobianSpatialVelocity(
-                c, JacobianWrtVariable.kV, frame, np.zeros(3), world, world
+        self._kinematics = declare_cached(self, "com and heels", self._calc_kinematics, state_only)
+        depends = {self._kinematics.ticket()}
+        for name, size, index in (("com_W", 3, 0), ("com_velocity_W", 3, 1), ("heel_x_W", 1, 2)):
+            self.DeclareVectorOutputPort(
+                name, size, self._reader(index), prerequisites_of_calc=depends
             )
-            tau += J_h.T @ F_h
-        M = plant.CalcMassMatrix(c)
-        J_com = plant.CalcJacobianCenterOfMassTranslationalVelocity(
-            c, JacobianWrtVariable.kV, world, world
+        self.DeclareVectorOutputPort(
+            "omega_f_W", 3, self._CalcOmegaF, prerequisites_of_calc={self._wrenches.ticket()}
         )
-        output.SetFromVector(J_com @ np.linalg.solve(M, tau))
 
-    def _CalcHeelX(self, context: Context, output: BasicVector) -> None:
-        c = self._sync(context)
-        world = self._plant.world_frame()
+    def _calc_kinematics(self, context: Context) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        plant, c = self._plant, self._context
+        plant.SetPositionsAndVelocities(c, self._instance, self._state.Eval(context))
+        world = plant.world_frame()
+        com = plant.CalcCenterOfMassPositionInWorld(c, [self._instance])
+        com_velocity = plant.CalcCenterOfMassTranslationalVelocityInWorld(c, [self._instance])
         xs = [
-            self._plant.CalcPointsPositions(c, frame, p.reshape(3, 1), world)[0, 0]
+            plant.CalcPointsPositions(c, frame, p.reshape(3, 1), world)[0, 0]
             for frame, p in self._heels
         ]
-        output.SetFromVector([max(xs)])
+        return com, com_velocity, np.array([max(xs)] if xs else [np.nan])
+
+    def _reader(self, index: int):
+        def calc(context: Context, output: BasicVector) -> None:
+            output.SetFromVector(self._kinematics.Eval(context)[index])
+
+        return calc
+
+    def _CalcOmegaF(self, context: Context, output: BasicVector) -> None:
+        """Omega f = J_com M^-1 sum_h J_h^T F_h (paper, Sec. II).
+
+        For a floating base whose translational velocity is the world-frame
+        velocity of its origin (Drake's quaternion floating joint), the CoM
+        Jacobian is the mass matrix's translational base rows over the mass,
+        J_com = M[3:6, :] / m, so J_com M^-1 = [0 I 0] / m and Omega f is the
+        hands' net force over the mass: the linear momentum theorem. Exact, and
+        free of a mass-matrix solve (tests check it against the formula).
+        """
+        F = self._wrenches.Eval(context)
+        output.SetFromVector((F[3:6] + F[9:12]) / self._mass_kg)

@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.analysis import Simulator
 
 from drake_standup.advancement import TrajectoryAdvancement, lead, psi_dot_law
@@ -133,16 +134,19 @@ def test_lead_gate_waits_while_the_com_lags():
     assert psi_dot_law(CFG, v, omega_f, TANGENT, -0.004)[0] > 1.7
 
 
-def test_omega_f_is_total_hand_force_over_mass():
-    """Omega f = J_com M^-1 sum J_h^T F_h must equal sum F/m: the linear
-    momentum theorem, whatever the configuration and wherever the force acts
-    (hand torques do not move the CoM)."""
+def test_omega_f_matches_the_papers_formula():
+    """RobotSensing returns sum F / m (linear momentum theorem); the paper's
+    Omega f = J_com M^-1 sum J_h^T F_h, computed here with Drake's mass matrix,
+    CoM Jacobian and hand Jacobians, must agree at any configuration, wherever
+    the force acts (hand torques do not move the CoM)."""
     plant = MultibodyPlant(0.0)
     robot = add_icub(plant, visuals=False, contact=ContactModel())
     plant.Finalize()
     sensing = RobotSensing(plant, robot, {})
     context = sensing.CreateDefaultContext()
-    mass = plant.CalcTotalMass(plant.CreateDefaultContext())
+    plant_context = plant.CreateDefaultContext()
+    world = plant.world_frame()
+    hands = [robot.frame(plant, name) for name in ("l_hand", "r_hand")]
     rng = np.random.default_rng(3)
     nq = plant.num_positions()
     for _ in range(5):
@@ -153,5 +157,27 @@ def test_omega_f_is_total_hand_force_over_mass():
         sensing.GetInputPort("robot_state").FixValue(context, x)
         sensing.GetInputPort("hand_wrenches_W").FixValue(context, wrenches)
         omega_f = sensing.GetOutputPort("omega_f_W").Eval(context)
-        expected = (wrenches[3:6] + wrenches[9:12]) / mass
+
+        plant.SetPositionsAndVelocities(plant_context, x)
+        tau = sum(
+            plant.CalcJacobianSpatialVelocity(
+                plant_context, JacobianWrtVariable.kV, frame, np.zeros(3), world, world
+            ).T
+            @ wrenches[6 * k : 6 * k + 6]
+            for k, frame in enumerate(hands)
+        )
+        J_com = plant.CalcJacobianCenterOfMassTranslationalVelocity(
+            plant_context, JacobianWrtVariable.kV, world, world
+        )
+        expected = J_com @ np.linalg.solve(plant.CalcMassMatrix(plant_context), tau)
         np.testing.assert_allclose(omega_f, expected, rtol=1e-8, atol=1e-10)
+        np.testing.assert_allclose(
+            sensing.GetOutputPort("com_W").Eval(context),
+            plant.CalcCenterOfMassPositionInWorld(plant_context),
+            atol=1e-12,
+        )
+        np.testing.assert_allclose(
+            sensing.GetOutputPort("com_velocity_W").Eval(context),
+            plant.CalcCenterOfMassTranslationalVelocityInWorld(plant_context),
+            atol=1e-12,
+        )

@@ -61,6 +61,16 @@ def _urdf_revolute_joint_names() -> set[str]:
     return {j.get("name") for j in _urdf_root().findall("joint") if j.get("type") == "revolute"}
 
 
+def _sdf_plane_height(path: Path, collision: str) -> float:
+    """Height of an SDF <plane> collision with normal +z (a half-space floor)."""
+    root = ET.parse(path).getroot()
+    (col,) = [c for c in root.iter("collision") if c.get("name") == collision]
+    normal = [float(s) for s in col.find("geometry/plane/normal").text.split()]
+    assert normal == [0.0, 0.0, 1.0], "floor plane must face up"
+    pose = col.find("pose")
+    return float(pose.text.split()[2]) if pose is not None else 0.0
+
+
 def _sdf_box_top(path: Path, collision: str) -> tuple[float, np.ndarray, np.ndarray]:
     """Top z and the x-y extent (lower, upper corners) of an axis-aligned SDF box."""
     root = ET.parse(path).getroot()
@@ -392,7 +402,7 @@ def test_seated_pad_rests_on_its_surface(seated, pad):
     lowest = _box_corners_W(X_WG, inspector.GetShape(gid))[:, 2].min()
 
     if spec["group"] == "sole":
-        floor_top, _, _ = _sdf_box_top(REPO / "models" / "floor.sdf", "floor_collision")
+        floor_top = _sdf_plane_height(REPO / "models" / "floor.sdf", "floor_collision")
         assert floor_top == 0.0
         assert abs(lowest - floor_top) <= PAD_GAP_TOL_M, f"{pad} lowest z = {lowest:.4f}"
     else:
