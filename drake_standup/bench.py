@@ -1,72 +1,446 @@
-"""Benchmark: simulated seconds per wall second, from one run of this script.
+"""Benchmark: how fast the stand-up simulates, and where the time goes (issue 5).
 
-    python -m drake_standup.bench [--scenario PATH] [--duration S] [--repeat N]
+    python -m drake_standup.bench [--scenario PATH] [--duration S] [--plant-duration S]
+                                  [--repeat N] [--plant-steps N] [--out FILE]
+                                  [--profile [PATH]]
 
-Prints a JSON summary. A benchmark, not a test: the machine is shared and
-noisy, so read ratios and medians, and compare figures from one run only.
+In one process, --repeat times each:
+  (a) plant_seat_hold: the seated hold under Drake's built-in joint PD, no controller,
+      --plant-duration simulated seconds (a stationary hold: a few are enough);
+  (b) closed_loop_recording: the scenario under the whole-body controller with the
+      Meshcat recording on, --duration simulated seconds (default: the scenario's);
+  (c) closed_loop: the same without the recording.
+Then the controller's tick split (WholeBodyController.timing_s()), the plant step
+timed one step at a time, the model build with a cold and a warm mesh cache, peak
+memory and the machine. One JSON summary goes to stdout (and to --out); progress
+goes to stderr. sim_s_per_wall_s is simulate()'s realtime_factor: simulated time
+over the wall time of the simulation loop only. (b) and (c) both write their
+outputs into a temporary directory, so call_wall_s (the whole simulate() call:
+build, loop, metrics, figures, diagram, and for (b) the recording's HTML) differs
+between them by the recording alone.
+
+A benchmark, not a test: the machine is shared and noisy, so read medians and
+ratios, and compare figures from one run of this script only.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import cProfile
+import hashlib
+import importlib.metadata
 import json
+import math
+import os
+import platform
+import pstats
+import resource
+import shutil
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
-from drake_standup.config import SCENARIO_DIR, ScenarioError, load_scenario
-from drake_standup.simulate import simulate
+import numpy as np
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from drake_standup.config import DEFAULT_SCENARIO, Scenario, ScenarioError, load_scenario
+from drake_standup.controller import WholeBodyController
+from drake_standup.diagram import build_diagram
+from drake_standup.scene import add_scene, set_seated_state
+from drake_standup.simulate import RunResult, simulate
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_PROFILE = Path("out") / "bench_profile.prof"
+PROFILE_TOP = 40  # functions listed in the profile's text summary
 
 
-def _rates(scenario, repeat: int, record: bool, controller: str) -> dict:
-    rates, build = [], []
-    for _ in range(repeat):
-        result = simulate(scenario, None, record=record, progress=False, controller=controller)
-        rates.append(result.metrics["realtime_factor"])
-        build.append(result.metrics["build_time_s"])
+def _log(message: str) -> None:
+    print(f"bench: {message}", file=sys.stderr, flush=True)
+
+
+def _stats(values: list[float]) -> dict:
     return {
-        "sim_s_per_wall_s": {
-            "median": statistics.median(rates),
-            "min": min(rates),
-            "max": max(rates),
-        },
-        "build_time_s_median": statistics.median(build),
-        "repetitions": repeat,
+        "median": statistics.median(values),
+        "min": min(values),
+        "max": max(values),
+        "values": values,
     }
 
 
+def _run(
+    scenario: Scenario, label: str, *, controller: str, record: bool, out_dir: Path | None
+) -> RunResult:
+    t0 = time.perf_counter()
+    result = simulate(scenario, out_dir, record=record, progress=False, controller=controller)
+    result.metrics["call_wall_s"] = time.perf_counter() - t0
+    _log(
+        f"{label}: {result.metrics['realtime_factor']:.3f} sim s / wall s "
+        f"({result.metrics['sim_time_s']:.2f} s simulated in {result.metrics['wall_time_s']:.1f} s)"
+    )
+    return result
+
+
+def _runs(
+    scenario: Scenario, name: str, repeat: int, *, controller: str, record: bool, outputs: bool
+) -> list[RunResult]:
+    results = []
+    for i in range(repeat):
+        with tempfile.TemporaryDirectory(prefix="bench_") as tmp:
+            out_dir = Path(tmp) if outputs else None
+            label = f"{name} {i + 1}/{repeat}"
+            results.append(
+                _run(scenario, label, controller=controller, record=record, out_dir=out_dir)
+            )
+    return results
+
+
+def _summary(results: list[RunResult], closed_loop: bool) -> dict:
+    metrics = [r.metrics for r in results]
+    summary = {
+        "sim_s_per_wall_s": _stats([m["realtime_factor"] for m in metrics]),
+        "sim_time_s": [m["sim_time_s"] for m in metrics],
+        "loop_wall_s": [m["wall_time_s"] for m in metrics],
+        "call_wall_s": [m["call_wall_s"] for m in metrics],
+        "build_time_s_median": statistics.median(m["build_time_s"] for m in metrics),
+        "repetitions": len(results),
+    }
+    if closed_loop:
+        summary["stood_up"] = [
+            {
+                "success": m["success"],
+                "failure_reason": m["failure_reason"],
+                "standup_time_s": m.get("standup_time_s"),
+                "qp_failures": m.get("qp_failures"),
+            }
+            for m in metrics
+        ]
+    recording = [m["recording_bytes"] for m in metrics if "recording_bytes" in m]
+    if recording:
+        summary["recording_bytes"] = recording
+    return summary
+
+
+def _tick_split(results: list[RunResult]) -> dict:
+    """Median, p95 and mean per column of WholeBodyController.timing_s(), in us,
+    over every tick of every run."""
+    timing = np.concatenate([r.controller_timing_s for r in results])
+    columns = [name.removesuffix("_s") + "_us" for name in WholeBodyController.TIMING]
+    us = 1e6 * timing
+    split = {
+        name: {
+            "median": float(np.median(us[:, k])),
+            "p95": float(np.percentile(us[:, k], 95)),
+            "mean": float(us[:, k].mean()),
+        }
+        for k, name in enumerate(columns)
+    }
+    # The parts are disjoint intervals inside the tick: what they leave of the
+    # total is the rest of the update (posture, state writes).
+    parts = us[:, :-1].sum(axis=1)
+    split["unaccounted_us"] = {
+        "median": float(np.median(us[:, -1] - parts)),
+        "mean": float((us[:, -1] - parts).mean()),
+    }
+    split["ticks"] = len(us)
+    return split
+
+
+def _step_times_s(simulator: Simulator, step_s: float, steps: int) -> list[float]:
+    """Advances one step at a time; wall time of each AdvanceTo."""
+    context = simulator.get_context()
+    simulator.Initialize()
+    times = []
+    for _ in range(steps):
+        target = context.get_time() + step_s
+        t0 = time.perf_counter()
+        simulator.AdvanceTo(target)
+        times.append(time.perf_counter() - t0)
+    return times
+
+
+def _step_stats(times_s: list[float]) -> dict:
+    us = 1e6 * np.asarray(times_s)
+    return {
+        "median": float(np.median(us)),
+        "p95": float(np.percentile(us, 95)),
+        "mean": float(us.mean()),
+        "steps": len(us),
+    }
+
+
+def _plant_step(scenario: Scenario, steps: int) -> dict:
+    """Wall time per 1 ms step of the seated hold, one AdvanceTo per step:
+    the bare plant and scene graph under the joint PD (fixed set point and gravity
+    feed-forward), and the whole seat-hold diagram of (a)."""
+    step_s = scenario.plant.time_step
+    builder = DiagramBuilder()
+    hold = scenario.seat_hold
+    scene = add_scene(builder, scenario, pd_gains=(hold.kp_Nm_per_rad, hold.kd_Nms_per_rad))
+    simulator = Simulator(builder.Build())
+    ApplySimulatorConfig(scenario.simulator, simulator)
+    plant, instance = scene.plant, scene.robot.model_instance
+    plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+    set_seated_state(scene, plant_context, scenario)
+    actuators = [plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(instance)]
+    q_desired = [actuator.joint().GetOnePosition(plant_context) for actuator in actuators]
+    plant.get_desired_state_input_port(instance).FixValue(
+        plant_context, np.concatenate([q_desired, np.zeros(len(actuators))])
+    )
+    tau_g = plant.CalcGravityGeneralizedForces(plant_context)
+    plant.get_actuation_input_port(instance).FixValue(
+        plant_context, plant.MakeActuationMatrix().T @ -tau_g
+    )
+    plant_only = _step_times_s(simulator, step_s, steps)
+
+    built = build_diagram(scenario, None, "seat_hold")
+    simulator = Simulator(built.diagram)
+    ApplySimulatorConfig(scenario.simulator, simulator)
+    set_seated_state(
+        built.scene,
+        built.scene.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()),
+        scenario,
+    )
+    diagram = _step_times_s(simulator, step_s, steps)
+    return {
+        "step_s": step_s,
+        "plant_and_scene_graph_us": _step_stats(plant_only),
+        "seat_hold_diagram_us": _step_stats(diagram),
+    }
+
+
+def _model_build(scenario: Scenario) -> dict:
+    """build_diagram() with a cold mesh cache (a fresh $DRAKE_STANDUP_CACHE: every
+    STL converted and decimated) and then warm (same cache). A first build with the
+    usual cache warms the process (imports, first parses) so the two differ by the
+    cache alone."""
+    t0 = time.perf_counter()
+    build_diagram(scenario, None)
+    first_s = time.perf_counter() - t0
+    saved = os.environ.get("DRAKE_STANDUP_CACHE")
+    cache = Path(tempfile.mkdtemp(prefix="bench_cache_"))
+    os.environ["DRAKE_STANDUP_CACHE"] = str(cache)
+    try:
+        t0 = time.perf_counter()
+        build_diagram(scenario, None)
+        cold_s = time.perf_counter() - t0
+        converted = len(list((cache / "meshes").glob("*.obj")))
+        t0 = time.perf_counter()
+        build_diagram(scenario, None)
+        warm_s = time.perf_counter() - t0
+    finally:
+        if saved is None:
+            del os.environ["DRAKE_STANDUP_CACHE"]
+        else:
+            os.environ["DRAKE_STANDUP_CACHE"] = saved
+        shutil.rmtree(cache, ignore_errors=True)
+    return {
+        "cold_cache_s": cold_s,
+        "warm_cache_s": warm_s,
+        "meshes_converted_cold": converted,
+        "first_build_in_process_s": first_s,
+    }
+
+
+def _profile(scenario: Scenario, path: Path) -> dict:
+    """cProfile of one closed-loop run (c); .prof and a text summary beside it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    profiler = cProfile.Profile()
+    with tempfile.TemporaryDirectory(prefix="bench_") as tmp:
+        profiler.enable()
+        result = simulate(
+            scenario, Path(tmp), record=False, progress=False, controller="whole_body"
+        )
+        profiler.disable()
+    profiler.dump_stats(path)
+    text_path = path.with_suffix(".txt")
+    with text_path.open("w") as f:
+        for key in ("cumulative", "tottime"):
+            f.write(f"Top {PROFILE_TOP} by {key} time\n")
+            pstats.Stats(str(path), stream=f).sort_stats(key).print_stats(PROFILE_TOP)
+    _log(f"profile written to {path} and {text_path}")
+    return {
+        "prof": str(path),
+        "text": str(text_path),
+        "sim_s_per_wall_s_under_profiler": result.metrics["realtime_factor"],
+    }
+
+
+def _machine() -> dict:
+    cpu_model = None
+    with contextlib.suppress(OSError):
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu_model = line.split(":", 1)[1].strip()
+                break
+    return {
+        "nproc": len(os.sched_getaffinity(0)),
+        "cpu_count": os.cpu_count(),
+        "cpu_model": cpu_model,
+        "drake": importlib.metadata.version("drake"),
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+    }
+
+
+def _git() -> dict:
+    """Commit, uncommitted files and a digest of their changes, so the figures can be
+    tied to the code (models and scenarios are read at every build, so a tree that
+    changes during the bench mixes versions)."""
+
+    def git(*args: str) -> str:
+        try:
+            done = subprocess.run(
+                ["git", *args], cwd=REPO_ROOT, capture_output=True, text=True, check=False
+            )
+        except OSError:
+            return ""
+        return done.stdout if done.returncode == 0 else ""
+
+    # Porcelain lines are "XY path": two status letters, a space, the path.
+    status = git("status", "--porcelain").splitlines()
+    return {
+        "commit": git("rev-parse", "HEAD").strip() or None,
+        "uncommitted": [line[3:] for line in status],
+        "diff_sha1": hashlib.sha1(git("diff", "HEAD", "--binary").encode()).hexdigest(),
+    }
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    value = float(text)
+    if not (math.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, got {text}")
+    return value
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--scenario", type=Path, default=DEFAULT_SCENARIO)
+    parser.add_argument(
+        "--duration",
+        type=_positive_float,
+        default=None,
+        help="simulated s per closed-loop run (b, c); default: the scenario's duration_s",
+    )
+    parser.add_argument(
+        "--plant-duration",
+        type=_positive_float,
+        default=3.0,
+        help="simulated s per plant-only seated hold (a); default 3",
+    )
+    parser.add_argument("--repeat", type=_positive_int, default=3, help="runs of each; default 3")
+    parser.add_argument(
+        "--plant-steps",
+        type=_positive_int,
+        default=300,
+        help="single steps timed for the plant step; default 300",
+    )
+    parser.add_argument("--out", type=Path, help="also write the JSON summary to this file")
+    parser.add_argument(
+        "--profile",
+        type=Path,
+        nargs="?",
+        const=DEFAULT_PROFILE,
+        help=f"cProfile one closed-loop run (c) into PATH (default {DEFAULT_PROFILE}) "
+        "and a text top-40 into PATH with suffix .txt",
+    )
+    return parser
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--scenario", type=Path, default=SCENARIO_DIR / "seated.yaml")
-    parser.add_argument("--duration", type=float, default=3.0, help="simulated s per repetition")
-    parser.add_argument("--repeat", type=int, default=3)
-    args = parser.parse_args(argv)
+    args = _parser().parse_args(argv)
+    t_bench = time.perf_counter()
+    git_start, load_start = _git(), list(os.getloadavg())
     try:
         scenario = load_scenario(args.scenario)
     except ScenarioError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    scenario.duration_s = args.duration
+    plant_scenario = load_scenario(args.scenario)
+    plant_scenario.duration_s = args.plant_duration
+    if args.duration is not None:
+        scenario.duration_s = args.duration
 
-    t0 = time.perf_counter()
-    plant_only = _rates(scenario, args.repeat, record=False, controller="seat_hold")
-    closed_loop = _rates(scenario, args.repeat, record=False, controller="whole_body")
+    # Anything a run prints (graphviz notices) must not reach the JSON on stdout.
+    with contextlib.redirect_stdout(sys.stderr):
+        _log("model build, cold and warm mesh cache")
+        build = _model_build(scenario)
+        _log("plant step, one step at a time")
+        plant_step = _plant_step(plant_scenario, args.plant_steps)
+        a = _runs(
+            plant_scenario,
+            "(a) plant_seat_hold",
+            args.repeat,
+            controller="seat_hold",
+            record=False,
+            outputs=False,
+        )
+        b = _runs(
+            scenario,
+            "(b) closed_loop_recording",
+            args.repeat,
+            controller="whole_body",
+            record=True,
+            outputs=True,
+        )
+        c = _runs(
+            scenario,
+            "(c) closed_loop",
+            args.repeat,
+            controller="whole_body",
+            record=False,
+            outputs=True,
+        )
+        profile = _profile(scenario, args.profile) if args.profile is not None else None
+
+    runs = {
+        "plant_seat_hold": _summary(a, closed_loop=False),
+        "closed_loop_recording": _summary(b, closed_loop=True),
+        "closed_loop": _summary(c, closed_loop=True),
+    }
+    median = {name: run["sim_s_per_wall_s"]["median"] for name, run in runs.items()}
     summary = {
         "scenario": str(args.scenario),
-        "duration_s": args.duration,
-        "seat_hold_plant_pd": plant_only,
-        "seat_hold_plant_pd_recording": _rates(
-            scenario, args.repeat, record=True, controller="seat_hold"
+        "duration_s": {"closed_loop": scenario.duration_s, "plant_seat_hold": args.plant_duration},
+        **runs,
+        "ratio_closed_loop_recording_to_plant_seat_hold": (
+            median["closed_loop_recording"] / median["plant_seat_hold"]
         ),
-        "whole_body_controller": closed_loop,
-        "ratio_closed_loop_to_plant_only": (
-            closed_loop["sim_s_per_wall_s"]["median"] / plant_only["sim_s_per_wall_s"]["median"]
+        "ratio_closed_loop_to_plant_seat_hold": median["closed_loop"] / median["plant_seat_hold"],
+        "ratio_closed_loop_recording_to_closed_loop": (
+            median["closed_loop_recording"] / median["closed_loop"]
         ),
-        "bench_wall_s": None,
+        "controller_tick": {"closed_loop": _tick_split(c), "closed_loop_recording": _tick_split(b)},
+        "plant_step": plant_step,
+        "model_build": build,
+        "profile": profile,
+        "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+        "machine": _machine(),
+        "load_average_1_5_15": {"start": load_start, "end": list(os.getloadavg())},
+        "git": git_start,
+        "bench_wall_s": time.perf_counter() - t_bench,
     }
-    summary["bench_wall_s"] = time.perf_counter() - t0
-    print(json.dumps(summary, indent=2))
+    summary["git"]["changed_during_bench"] = changed = _git() != git_start
+    if changed:
+        _log("warning: the working tree changed during the bench; its figures mix versions")
+    text = json.dumps(summary, indent=2, allow_nan=False)
+    print(text)
+    if args.out is not None:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(text + "\n")
     return 0
 
 

@@ -31,6 +31,9 @@ class RunResult:
     # Logged signal name -> (sample times (N,), data (size, N)).
     signals: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     pad_groups: dict[str, str] = field(default_factory=dict)  # pad -> group, log order
+    # WholeBodyController.timing_s(): per-tick compute times, (ticks, 5) in the
+    # columns of WholeBodyController.TIMING; None without that controller.
+    controller_timing_s: np.ndarray | None = None
 
     @property
     def times_s(self) -> np.ndarray:
@@ -155,6 +158,8 @@ def _simulate_one(
         bar.close()
 
     result = _collect(built, root_context, scenario)
+    if built.controller is not None:
+        result.controller_timing_s = built.controller.timing_s()
     sim_time_s = root_context.get_time()
     standing = result.metrics.get("standing_at_end", False)
     if failure_reason is None and built.controller is not None and not standing:
