@@ -34,16 +34,24 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
 from drake_standup.control.contacts import NORMAL, WRENCH_SIZE, ContactSpec
-from drake_standup.control.qp import SOLVERS, ContactCommand, QpLayout, QpSolution, WholeBodyQp
+from drake_standup.control.qp import (
+    SOLVERS,
+    ContactCommands,
+    QpLayout,
+    QpSolution,
+    WholeBodyQp,
+    as_slice,
+)
 from drake_standup.control.spatial import yaw_pitch_rotation
 from drake_standup.control.tasks import (
+    base_orientation_reference,
     base_orientation_task,
     com_acceleration_reference,
     cop_centering_task,
-    hand_wrench_about_com,
     helpful_force,
     joint_limit_acceleration_bounds,
     momentum_task,
+    posture_acceleration_reference,
     posture_task,
 )
 from drake_standup.control.terms import BASE_BODY, RobotKinematics, RobotTerms
@@ -286,6 +294,8 @@ class WholeBodyController(LeafSystem):
 
     CONTACTS = ("seat", "l_thigh", "r_thigh", "l_sole", "r_sole")
     HANDS = ("l_hand", "r_hand")
+    # Entry of contact_plan that scales each contact: seat_scale (1) or feet_scale (2).
+    PLAN_SCALE = {"seat": 1, "l_thigh": 1, "r_thigh": 1, "l_sole": 2, "r_sole": 2}
     # Layout of the diagnostics output.
     DIAGNOSTICS = (
         "qp_ok",  # 1 if this tick's QP succeeded, else 0 (torques held)
@@ -318,18 +328,21 @@ class WholeBodyController(LeafSystem):
         self._period_s = period_s
         self._B = plant.MakeActuationMatrix()
         self._nv, self._nu = nv, nu = self._B.shape
-        self._gravity_W = plant.gravity_field().gravity_vector()
         self.contact_specs = _contact_specs(plant, robot, config)
         held_frames = [spec.frame for spec in self.contact_specs if spec.constrained]
         self._joints = joints = _actuated_joints(plant, robot, held_frames)
-        self._posture_tables, self._posture_weights = self._posture_setup(config, joints.names)
+        self._posture_setup(config, joints)
         self._kinematics = RobotKinematics(
             plant,
             robot,
             held_frames=held_frames,
             other_frames=[spec.frame for spec in self.contact_specs if not spec.constrained]
             + list(self.HANDS),
+            hold_points_m={spec.frame: spec.hold_point_m for spec in self.contact_specs},
         )
+        # The weight's wrench about the CoM, [0; m g], N.
+        self._W_gravity = np.zeros(6)
+        self._W_gravity[3:] = self._kinematics.mass_kg * plant.gravity_field().gravity_vector()
         # CoM gains (K_P, K_D) seated (True) and standing (False).
         self._com_gains = {
             seated: (np.array(kp), 2.0 * config.com_damping_ratio * np.sqrt(kp))
@@ -338,8 +351,17 @@ class WholeBodyController(LeafSystem):
                 (False, config.com_kp_standing_per_s2),
             )
         }
-        # One program per set of active contacts, built when first needed.
-        self._programs: dict[tuple[bool, ...], WholeBodyQp] = {}
+        # Held rows of the seat's acceleration from seat_hinge_from_state: all but the
+        # pitch about the hip axis (alpha_y in C).
+        self._hinged_rows = np.ones(WRENCH_SIZE, dtype=bool)
+        self._hinged_rows[1] = False
+        self._hands = list(self.HANDS)
+        self._latched = np.ones(1)  # the posture state's latched flag
+        # The base's target orientation for the last (yaw, pitch), rad.
+        self._base_target = (None, None), None
+        # One program per set of active contacts (seat and thighs, soles), built when
+        # first needed.
+        self._programs: dict[tuple[bool, bool], _Program] = {}
         self._timing: list[tuple[float, ...]] = []
 
         nx = plant.num_positions(robot.model_instance) + nv
@@ -358,13 +380,11 @@ class WholeBodyController(LeafSystem):
         self.DeclareInitializationDiscreteUpdateEvent(self._Update)
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
 
-    @staticmethod
-    def _posture_setup(
-        config: ControllerConfig, names: list[str]
-    ) -> tuple[dict[int, np.ndarray], np.ndarray]:
-        """Posture tables by state (actuator order, NaN: hold the state-1 posture) and
-        the per-joint posture weights; unknown joint names are an error."""
-        tables = {1: np.full(len(names), np.nan)}
+    def _posture_setup(self, config: ControllerConfig, joints: _Joints) -> None:
+        """Posture targets by state (actuator order, clamped inside the joint limits; NaN:
+        hold the state-1 posture) and the per-joint posture weights; the index arrays,
+        gains and limits the tick needs. Unknown joint names are an error."""
+        names = joints.names
         named = {
             "posture_state2_rad": config.posture_state2_rad,
             "posture_state3_rad": config.posture_state3_rad,
@@ -375,13 +395,34 @@ class WholeBodyController(LeafSystem):
             unknown = sorted(set(table) - set(names))
             if unknown:
                 raise ValueError(f"controller.{key}: unknown joint(s) {', '.join(unknown)}")
+        margin = config.posture_limit_margin_rad
+        self._q_target_min = joints.q_min + margin
+        self._q_target_max = joints.q_max - margin
+        tables = {1: np.full(len(names), np.nan)}
         for state in (2, 3, 4):
             table = named[f"posture_state{state}_rad"]
             tables[state] = np.array([table.get(name, np.nan) for name in names])
-        weights = np.array(
+        # (clamped table, True where the joint holds the state-1 posture) by state.
+        self._posture_targets = {
+            state: (np.clip(table, self._q_target_min, self._q_target_max), np.isnan(table))
+            for state, table in tables.items()
+        }
+        self._posture_weights = np.array(
             [config.posture_weight_by_joint.get(name, config.posture_weight) for name in names]
         )
-        return tables, weights
+        self._q_joints = as_slice(joints.q_indices)
+        self._v_joints = as_slice(joints.v_indices)
+        limited = joints.limited
+        self._limited_q = as_slice(joints.q_indices[limited])
+        self._limited_v = joints.v_indices[limited]
+        self._limited_rates = as_slice(self._limited_v)
+        self._limited_q_min = joints.q_min[limited]
+        self._limited_q_max = joints.q_max[limited]
+        self._kp_q = config.posture_kp_per_s2
+        self._kd_q = 2.0 * config.posture_damping_ratio * math.sqrt(self._kp_q)
+        self._kp_b = config.base_orientation_kp_per_s2
+        self._kd_b = 2.0 * config.base_orientation_damping_ratio * math.sqrt(self._kp_b)
+        self._blend = min(self._period_s / config.posture_filter_time_constant_s, 1.0)
 
     # --- Timing --------------------------------------------------------------------
 
@@ -403,18 +444,15 @@ class WholeBodyController(LeafSystem):
         t_start = time.perf_counter()
         x = self._state_port.Eval(context)
         com_reference = self._reference_port.Eval(context)
-        standup_state, seat_scale, feet_scale = self._plan_port.Eval(context)
+        plan = self._plan_port.Eval(context)
         F_hand_W = self._hands_port.Eval(context)
         t_inputs = time.perf_counter()
 
+        standup_state, seat_scale, feet_scale = plan.tolist()
         standup_state = min(max(int(round(standup_state)), 1), 4)
-        scales = {"seat": seat_scale, "l_thigh": seat_scale, "r_thigh": seat_scale}
-        scales.update(l_sole=feet_scale, r_sole=feet_scale)
-        active = tuple(scales[spec.frame] > 0.0 for spec in self.contact_specs)
-        program = self._program(active)
-        pulled = bool(np.any(F_hand_W))
-        frames = [spec.frame for spec in program.contacts] + (list(self.HANDS) if pulled else [])
-        terms = self._kinematics.calc(x, frames)
+        program = self._program((seat_scale > 0.0, feet_scale > 0.0))
+        pulled = bool(F_hand_W.any())
+        terms = self._kinematics.calc(x, program.frames, self._hands if pulled else ())
         t_kinematics = time.perf_counter()
 
         # Centroidal momentum: xddot*, the helpful part of the pull, Ldot*.
@@ -422,10 +460,17 @@ class WholeBodyController(LeafSystem):
         xddot_star = com_acceleration_reference(
             terms.p_WCom, terms.v_WCom, com_reference, kp_com, kd_com
         )
-        f_par = np.zeros(3)
+        state = context.get_discrete_state()
+        Ldot_star = np.empty(6)
+        Ldot_star[:3] = -config.angular_momentum_kd_per_s * terms.L_WCom[:3]
+        Ldot_star[:3] -= config.angular_momentum_kp_per_s2 * state.get_value(
+            self._momentum_integral
+        )
+        Ldot_star[3:] = terms.mass_kg * xddot_star
+        f_par = tau_hand = None
         if pulled:
             xd_dot = com_reference[3:6]
-            speed = np.linalg.norm(xd_dot)
+            speed = math.sqrt(float(xd_dot @ xd_dot))
             lead_m = (terms.p_WCom - com_reference[:3]) @ xd_dot / speed if speed > 0.0 else 0.0
             f_par = helpful_force(
                 F_hand_W[3:6] + F_hand_W[9:12],
@@ -434,62 +479,58 @@ class WholeBodyController(LeafSystem):
                 config.help_fade_speed_mps,
                 config.help_max_lead_m,
             )
-        momentum_integral = context.get_discrete_state(self._momentum_integral).value()
-        Ldot_star = np.concatenate(
-            [
-                -config.angular_momentum_kd_per_s * terms.L_WCom[:3]
-                - config.angular_momentum_kp_per_s2 * momentum_integral,
-                terms.mass_kg * xddot_star + f_par,
-            ]
-        )
-        tau_hand = np.zeros(self._nv)
-        W_hand_Com = np.zeros(6)
-        if pulled:
-            tau_hand = sum(
-                terms.frames[name].J_WF.T @ F_hand_W[6 * k : 6 * (k + 1)]
-                for k, name in enumerate(self.HANDS)
-            )
-            W_hand_Com = hand_wrench_about_com(terms, list(self.HANDS), F_hand_W)
+            Ldot_star[3:] += f_par
+            # J_h^T F_hand, both hands.
+            tau_hand = terms.J_W.reshape(12, self._nv).T @ F_hand_W
         tasks = [
             momentum_task(
-                terms,
-                program.layout,
-                program.contacts,
+                program.qp.layout,
+                program.qp.contact_map(terms),
+                terms.p_BoCom,
                 Ldot_star,
-                W_hand_Com,
-                self._gravity_W,
+                None if tau_hand is None else tau_hand[:6],
+                self._W_gravity,
                 config.momentum_weight,
             )
         ]
-        posture, posture_tasks = self._posture_tasks(context, terms, standup_state, program)
-        tasks += posture_tasks
-
-        commands = self._contact_commands(program.contacts, standup_state, scales)
-        vdot_min, vdot_max = self._joint_limit_bounds(terms)
+        posture, targets = self._posture_targets_of(
+            state.get_value(self._posture), terms, standup_state
+        )
+        commands = self._contact_commands(program, standup_state, plan)
+        vdot_min, vdot_max = joint_limit_acceleration_bounds(
+            terms.q[self._limited_q],
+            terms.v[self._limited_rates],
+            self._limited_q_min,
+            self._limited_q_max,
+            config.joint_limit_horizon_s,
+        )
         t_tasks = time.perf_counter()
-        solution = program.solve(terms, tasks, commands, tau_hand, vdot_min, vdot_max)
+        solution = program.qp.solve(terms, tasks, targets, commands, tau_hand, vdot_min, vdot_max)
 
         normal_forces_N = np.zeros(len(self.CONTACTS))
-        for frame, F in zip(solution.frames, solution.F_C, strict=True):
-            normal_forces_N[self.CONTACTS.index(frame)] = F[NORMAL]
+        normal_forces_N[program.contact_index] = solution.F_C[:, NORMAL]
         return ControllerTick(
             solution=solution,
             terms=terms,
             normal_forces_N=normal_forces_N,
-            helpful_force_W=f_par,
+            helpful_force_W=np.zeros(3) if f_par is None else f_par,
             posture=posture,
             inputs_s=t_inputs - t_start,
             kinematics_s=t_kinematics - t_inputs,
             assembly_s=t_tasks - t_kinematics + solution.assembly_s,
         )
 
-    def _program(self, active: tuple[bool, ...]) -> WholeBodyQp:
-        """The QP over the active contacts (built at the first tick that needs it)."""
-        if active not in self._programs:
+    def _program(self, active: tuple[bool, bool]) -> "_Program":
+        """The QP over the active contacts (seat and thighs, soles: built at the first
+        tick that needs it)."""
+        program = self._programs.get(active)
+        if program is None:
             config = self._config
-            contacts = [spec for spec, on in zip(self.contact_specs, active, strict=True) if on]
+            contacts = [
+                spec for spec in self.contact_specs if active[self.PLAN_SCALE[spec.frame] - 1]
+            ]
             layout = QpLayout.of(contacts, self._nv)
-            self._programs[active] = WholeBodyQp(
+            qp = WholeBodyQp(
                 contacts,
                 self._B,
                 torque_limit_Nm=config.torque_limit_Nm,
@@ -497,120 +538,119 @@ class WholeBodyController(LeafSystem):
                 wrench_weight=config.wrench_weight,
                 acceleration_weight=config.acceleration_weight,
                 fixed_tasks=[cop_centering_task(layout, contacts, config.cop_centering_weight)],
+                tracking_tasks=[
+                    posture_task(layout, self._joints.v_indices, self._posture_weights),
+                    base_orientation_task(layout, config.base_orientation_weight),
+                ],
+                bounded_accelerations=self._limited_v,
                 solver=config.qp_solver,
             )
-        return self._programs[active]
+            soles = np.array([spec.frame in ("l_sole", "r_sole") for spec in contacts])
+            program = _Program(
+                qp=qp,
+                frames=qp.frames,
+                contact_index=[self.CONTACTS.index(spec.frame) for spec in contacts],
+                plan_index=np.array([self.PLAN_SCALE[spec.frame] for spec in contacts]),
+                soles=soles,
+                partially_held={
+                    False: {},
+                    True: {
+                        c: self._hinged_rows
+                        for c, spec in enumerate(contacts)
+                        if spec.constrained and not soles[c]
+                    },
+                },
+            )
+            self._programs[active] = program
+        return program
 
-    def _joint_limit_bounds(self, terms: RobotTerms) -> tuple[np.ndarray, np.ndarray]:
-        """vdot bounds: the limited joints' limit bounds, +-inf elsewhere."""
-        joints = self._joints
-        limited = joints.limited
-        lower, upper = joint_limit_acceleration_bounds(
-            terms.q[joints.q_indices[limited]],
-            terms.v[joints.v_indices[limited]],
-            joints.q_min[limited],
-            joints.q_max[limited],
-            self._config.joint_limit_horizon_s,
-        )
-        vdot_min = np.full(self._nv, -np.inf)
-        vdot_max = np.full(self._nv, np.inf)
-        vdot_min[joints.v_indices[limited]] = lower
-        vdot_max[joints.v_indices[limited]] = upper
-        return vdot_min, vdot_max
-
-    def _posture_tasks(
-        self, context: Context, terms: RobotTerms, standup_state: int, program: WholeBodyQp
-    ):
-        """Posture and base-orientation tasks; the posture state after this tick.
+    def _posture_targets_of(
+        self, posture: np.ndarray, terms: RobotTerms, standup_state: int
+    ) -> tuple[np.ndarray, list[np.ndarray]]:
+        """The posture state after this tick (posture: its value before); the targets of
+        the posture and base orientation tasks.
 
         qddot* = -K_P (q - q_ref) - K_D qdot, q_ref low-pass filtered toward the state's
         table (joints not in it: the posture latched at the first tick); the base is held
         at the yaw of the first tick, pitched forward by the state's base pitch.
         """
-        config, nu, joints = self._config, self._nu, self._joints
-        posture = context.get_discrete_state(self._posture).value()
-        q_joints = terms.q[joints.q_indices]
+        nu = self._nu
+        q_joints = terms.q[self._q_joints]
         if posture[0] > 0.5:
             q_initial, q_reference = posture[1 : 1 + nu], posture[1 + nu : 1 + 2 * nu]
             base_yaw = posture[-1]
         else:
             q_initial, q_reference = q_joints, q_joints
             base_yaw = math.atan2(terms.R_WB[1, 0], terms.R_WB[0, 0])
-        table = self._posture_tables[standup_state]
-        margin = config.posture_limit_margin_rad
-        q_target = np.clip(
-            np.where(np.isnan(table), q_initial, table),
-            joints.q_min + margin,
-            joints.q_max - margin,
+        table, hold = self._posture_targets[standup_state]
+        q_next = np.where(
+            hold, np.minimum(np.maximum(q_initial, self._q_target_min), self._q_target_max), table
         )
-        kp_q = config.posture_kp_per_s2
-        kd_q = 2.0 * config.posture_damping_ratio * math.sqrt(kp_q)
-        qddot_star = -kp_q * (q_joints - q_reference) - kd_q * terms.v[joints.v_indices]
-        blend = min(self._period_s / config.posture_filter_time_constant_s, 1.0)
-        next_posture = np.concatenate(
-            [[1.0], q_initial, q_reference + blend * (q_target - q_reference), [base_yaw]]
+        # The reference's next value: q_ref + blend (q_target - q_ref).
+        q_next -= q_reference
+        q_next *= self._blend
+        q_next += q_reference
+        next_posture = np.concatenate((self._latched, q_initial, q_next, (base_yaw,)))
+        qddot_star = posture_acceleration_reference(
+            q_joints, terms.v[self._v_joints], q_reference, self._kp_q, self._kd_q
         )
-        kp_b = config.base_orientation_kp_per_s2
         # root_link's x axis points backwards: a forward pitch is about its -y.
-        pitch = config.base_pitch_by_state_rad[standup_state - 1]
-        tasks = [
-            posture_task(program.layout, joints.v_indices, qddot_star, self._posture_weights),
-            base_orientation_task(
-                terms,
-                program.layout,
-                yaw_pitch_rotation(base_yaw, -pitch),
-                kp_b,
-                2.0 * config.base_orientation_damping_ratio * math.sqrt(kp_b),
-                config.base_orientation_weight,
-            ),
-        ]
-        return next_posture, tasks
+        key = (base_yaw, self._config.base_pitch_by_state_rad[standup_state - 1])
+        if key != self._base_target[0]:
+            self._base_target = key, yaw_pitch_rotation(key[0], -key[1])
+        wdot_star = base_orientation_reference(
+            terms.R_WB, terms.v[:3], self._base_target[1], self._kp_b, self._kd_b
+        )
+        return next_posture, [qddot_star, wdot_star]
 
     def _contact_commands(
-        self, contacts: list[ContactSpec], standup_state: int, scales: dict[str, float]
-    ) -> list[ContactCommand]:
+        self, program: "_Program", standup_state: int, plan: np.ndarray
+    ) -> ContactCommands:
         """Normal-force bounds from the plan: seat and thighs in seat_scale * [f_min,
         f_max_seat], soles in [feet_scale * f_min, f_max_foot]. The seat holds all six
         rows until seat_hinge_from_state, then all but the pitch about the hip axis."""
         config = self._config
-        commands = []
-        for spec in contacts:
-            scale = scales[spec.frame]
-            held_rows = np.ones(WRENCH_SIZE, dtype=bool)
-            if spec.frame in ("l_sole", "r_sole"):
-                max_normal_force_N = config.foot_max_normal_force_N
-            else:
-                max_normal_force_N = scale * config.seat_max_normal_force_N
-                held_rows[1] = standup_state < config.seat_hinge_from_state  # alpha_y in C
-            commands.append(
-                ContactCommand(scale * config.min_normal_force_N, max_normal_force_N, held_rows)
-            )
-        return commands
+        scales = plan[program.plan_index]
+        max_normal_force_N = np.where(
+            program.soles, config.foot_max_normal_force_N, scales * config.seat_max_normal_force_N
+        )
+        return ContactCommands(
+            scales * config.min_normal_force_N,
+            max_normal_force_N,
+            program.partially_held[standup_state >= config.seat_hinge_from_state],
+        )
 
     def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
         t_start = time.perf_counter()
         tick = self.CalcTick(context)
         solution = tick.solution
-        previous = context.get_discrete_state(self._diagnostics).value()
-        failures = previous[1] + (0.0 if solution.ok else 1.0)
+        state = context.get_discrete_state()
+        failures = state.get_value(self._diagnostics)[1] + (0.0 if solution.ok else 1.0)
         if solution.ok:  # on failure the last torques stay in the actuation state
-            discrete_state.get_mutable_vector(self._actuation).SetFromVector(solution.tau)
-        integral = context.get_discrete_state(self._momentum_integral).value()
-        discrete_state.get_mutable_vector(self._momentum_integral).SetFromVector(
-            integral + self._period_s * tick.terms.L_WCom[:3]
-        )
-        discrete_state.get_mutable_vector(self._posture).SetFromVector(tick.posture)
+            discrete_state.set_value(self._actuation, solution.tau)
+        integral = state.get_value(self._momentum_integral) + self._period_s * tick.terms.L_WCom[:3]
+        discrete_state.set_value(self._momentum_integral, integral)
+        discrete_state.set_value(self._posture, tick.posture)
         total_s = time.perf_counter() - t_start
-        normal_forces = tick.normal_forces_N if solution.ok else np.full(len(self.CONTACTS), np.nan)
-        discrete_state.get_mutable_vector(self._diagnostics).SetFromVector(
-            np.concatenate(
-                [
-                    [float(solution.ok), failures, solution.solve_s, total_s],
-                    normal_forces,
-                    [np.linalg.norm(tick.helpful_force_W)],
-                ]
-            )
-        )
+        diagnostics = np.empty(len(self.DIAGNOSTICS))
+        f_par = tick.helpful_force_W
+        diagnostics[:4] = float(solution.ok), failures, solution.solve_s, total_s
+        diagnostics[4:-1] = tick.normal_forces_N if solution.ok else np.nan
+        diagnostics[-1] = math.sqrt(float(f_par @ f_par))
+        discrete_state.set_value(self._diagnostics, diagnostics)
         self._timing.append(
             (tick.inputs_s, tick.kinematics_s, tick.assembly_s, solution.solve_s, total_s)
         )
+
+
+@dataclass
+class _Program:
+    """A WholeBodyQp and what the tick needs to know of its contacts."""
+
+    qp: WholeBodyQp
+    frames: list[str]  # its contacts' frames, the frames terms are asked for
+    contact_index: list[int]  # of each contact in WholeBodyController.CONTACTS
+    plan_index: np.ndarray  # of each contact's scale in contact_plan
+    soles: np.ndarray  # True for a sole
+    # ContactCommands.partially_held before (False) and from (True) seat_hinge_from_state.
+    partially_held: dict[bool, dict[int, np.ndarray]]

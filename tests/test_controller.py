@@ -229,7 +229,9 @@ def test_static_seated_reference_balances_gravity(scene):
 def test_com_jacobian_bias_and_momentum_from_the_mass_matrix(scene):
     """With the floating-base velocities expressed in W (SPEC 5), on random states:
     M[3:6]/m = J_com, Cv[3:6]/m = Jdot_com v, M[3:6]^T g = tau_g, and the controller's
-    centroidal momentum equals Drake's spatial momentum about the CoM."""
+    CoM (read off M[0:3, 3:6] = m [p_BoCom]x), centroidal momentum and base orientation
+    (from the quaternion) equal Drake's CoM, spatial momentum about the CoM and root_link
+    pose."""
     scene, x0 = scene
     plant, robot = scene.plant, scene.robot
     instance = robot.model_instance
@@ -261,6 +263,64 @@ def test_com_jacobian_bias_and_momentum_from_the_mass_matrix(scene):
         np.testing.assert_allclose(terms.L_WCom[:3], L.rotational(), atol=1e-9)
         np.testing.assert_allclose(terms.L_WCom[3:], L.translational(), atol=1e-9)
         np.testing.assert_allclose(terms.v_WCom, J_com @ x[plant.num_positions() :], atol=1e-9)
+        base = plant.GetBodyByName("root_link", instance)
+        np.testing.assert_allclose(
+            terms.R_WB, plant.EvalBodyPoseInWorld(context, base).rotation().matrix(), atol=1e-14
+        )
+
+
+def test_hold_point_velocity_and_bias_acceleration_by_finite_differences(scene):
+    """For the held frames (the seat, held at the hip axis on root_link: the analytic bias
+    w x (w x p_BoP); the soles: Drake's), on random states, with the Jacobians expressed
+    in each frame F: R_WF J_P v is [w_WF; v_WP] with v_WP the finite-difference velocity
+    of the hold point P (from frame poses), and R_WF Jdot_P v is the finite-difference
+    derivative of R_WF J_P v along the motion at constant v (central differences,
+    q +- qdot dt)."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    controller, _ = _controller(scene)
+    held = [spec for spec in controller.contact_specs if spec.constrained]
+    names = [spec.frame for spec in held]
+    kinematics = RobotKinematics(
+        plant,
+        robot,
+        held_frames=names,
+        other_frames=[],
+        hold_points_m={spec.frame: spec.hold_point_m for spec in held},
+    )
+    assert any(spec.hold_point_m != (0.0, 0.0, 0.0) for spec in held)  # the seat's hinge
+    context = plant.CreateDefaultContext()
+    nq, dt = plant.num_positions(), 1e-6
+
+    def in_world(x):
+        """Per held frame: p_WP, R_WF and the spatial velocity of P in W."""
+        plant.SetPositionsAndVelocities(context, instance, x)
+        terms = kinematics.calc(x, names)
+        result = []
+        for j, spec in enumerate(held):
+            X_WF = robot.frame(plant, spec.frame).CalcPoseInWorld(context)
+            R_WF = X_WF.rotation().matrix()
+            V_WP = (R_WF @ (terms.J_P[j] @ x[nq:]).reshape(2, 3).T).T.reshape(6)
+            result.append((X_WF @ np.array(spec.hold_point_m), R_WF, V_WP))
+        return terms, result
+
+    rng = np.random.default_rng(5)
+    for _ in range(N_SAMPLES // 2):
+        x = _random_state(plant, instance, x0, rng)
+        q, v = x[:nq], x[nq:]
+        plant.SetPositionsAndVelocities(context, instance, x)
+        qdot = plant.MapVelocityToQDot(context, v)
+        terms, now = in_world(x)
+        _, ahead = in_world(np.concatenate([q + dt * qdot, v]))
+        _, behind = in_world(np.concatenate([q - dt * qdot, v]))
+        for j in range(len(held)):
+            _, R_WF, V_WP = now[j]
+            v_WP = (ahead[j][0] - behind[j][0]) / (2 * dt)
+            np.testing.assert_allclose(V_WP[3:], v_WP, atol=1e-6 * max(1.0, np.abs(v_WP).max()))
+            A_WP = (ahead[j][2] - behind[j][2]) / (2 * dt)
+            Jdotv_WP = (R_WF @ terms.Jdotv_P[j].reshape(2, 3).T).T.reshape(6)
+            np.testing.assert_allclose(Jdotv_WP, A_WP, atol=1e-5 * max(1.0, np.abs(A_WP).max()))
 
 
 # --- The human's help ------------------------------------------------------------------------
@@ -348,6 +408,56 @@ def test_drake_solvers_agree_with_daqp(scene, solver):
     assert reference.ok and other.ok
     np.testing.assert_allclose(other.tau, reference.tau, atol=0.05)  # OSQP: first-order
     np.testing.assert_allclose(other.F_W, reference.F_W, atol=1e-1)
+
+
+def test_binding_torque_limits(scene):
+    """With a 20 N m torque limit on a random state the limits bind (the program tried
+    first without them must be solved again with them): |tau| <= 20 N m, some at the
+    limit, and Clarabel finds the same torques and wrenches."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    x = _random_state(plant, instance, x0, np.random.default_rng(11))
+    com = _com(plant, instance, x)
+    solutions = []
+    for name in ("daqp", "clarabel"):
+        controller, context = _controller(scene, qp_solver=name, torque_limit_Nm=20.0)
+        _fix_inputs(controller, context, x, np.concatenate([com, np.zeros(6)]), [2, 1, 1])
+        solutions.append(controller.CalcTick(context).solution)
+    reference, other = solutions
+    assert reference.ok and other.ok
+    assert np.abs(reference.tau).max() <= 20.0 + 1e-6
+    assert np.abs(reference.tau).max() >= 20.0 - 1e-6
+    np.testing.assert_allclose(other.tau, reference.tau, atol=0.05)
+    np.testing.assert_allclose(other.F_W, reference.F_W, atol=1e-1)
+
+
+def test_seat_hinge_follows_the_plan(scene):
+    """One controller ticking states 1, 2, 1 on the same inputs (the seat's pitch row
+    held, free, held again) gives what fresh controllers give in those states."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    x = _random_state(plant, instance, x0, np.random.default_rng(12))
+    reference = np.concatenate([_com(plant, instance, x), np.zeros(6)])
+    controller, context = _controller(scene)
+    for standup_state in (1, 2, 1):
+        _fix_inputs(controller, context, x, reference, [standup_state, 1, 1])
+        solution = controller.CalcTick(context).solution
+        fresh, fresh_context = _controller(scene)
+        _fix_inputs(fresh, fresh_context, x, reference, [standup_state, 1, 1])
+        expected = fresh.CalcTick(fresh_context).solution
+        assert solution.ok and expected.ok
+        np.testing.assert_allclose(solution.tau, expected.tau, atol=1e-9)
+        np.testing.assert_allclose(solution.vdot, expected.vdot, atol=1e-9)
+    # The hinge frees the seat's pitch: the two states differ.
+    assert np.abs(solution.tau - _solution_in_state(scene, x, reference, 2).tau).max() > 1e-3
+
+
+def _solution_in_state(scene, x, reference, standup_state):
+    controller, context = _controller(scene)
+    _fix_inputs(controller, context, x, reference, [standup_state, 1, 1])
+    return controller.CalcTick(context).solution
 
 
 def test_ports_and_config(scene):

@@ -9,9 +9,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from drake_standup.control.spatial import skew
-from drake_standup.control.terms import FrameTerms
-
 WRENCH_SIZE = 6
 # Index of the normal force f_z in F_C = [tau_x, tau_y, tau_z, f_x, f_y, f_z].
 NORMAL = 5
@@ -79,23 +76,3 @@ def wrench_cone_matrix(spec: ContactSpec) -> np.ndarray:
             [-1.0, 0.0, 0.0, 0.0, 0.0, y_min],
         ]
     )
-
-
-def held_point_terms(
-    frame: FrameTerms, v: np.ndarray, p_CP: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Spatial velocity Jacobian J_WP and bias acceleration Jdot_WP v of a point P fixed
-    on the contact frame's body (p_CP in C), rows expressed in W:
-
-        v_P = v_C + w x p_CP,   a_P,bias = a_C,bias + alpha_bias x p_CP + w x (w x p_CP).
-    """
-    J, bias = frame.J_WF, frame.Jdotv_WF
-    if p_CP.any():
-        p_CP_W = frame.R_WF @ p_CP
-        p_skew = skew(p_CP_W)
-        J = J.copy()
-        J[3:] -= p_skew @ J[:3]
-        w_skew = skew(frame.J_WF[:3] @ v)
-        bias = bias.copy()
-        bias[3:] += w_skew @ (w_skew @ p_CP_W) - p_skew @ bias[:3]
-    return J, bias

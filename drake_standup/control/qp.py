@@ -23,10 +23,17 @@ The program holds only the contacts that are active: the controller keeps one pe
 of active contacts (its size, and so its solve time, shrinks once the seat is released).
 The tasks (A_k, b_k, w_k) come from control/tasks.py; the solver is a backend chosen by
 name (daqp, or Drake's OSQP / Clarabel).
+
+The torque limits rarely bind (never in the default scenario's closed loop): each tick
+first solves without them, and again with them only if the torques come out beyond the
+limits. A solution within the limits is also the optimum with them (the program is
+strictly convex), and daqp solves it 10-20 % faster without their nu rows (measured).
 """
 
 import time
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property
 
 import daqp
 import numpy as np
@@ -37,16 +44,10 @@ from pydrake.solvers import (
     SolverOptions,
 )
 
-from drake_standup.control.contacts import (
-    WRENCH_SIZE,
-    ContactSpec,
-    held_point_terms,
-    wrench_cone_matrix,
-)
+from drake_standup.control.contacts import WRENCH_SIZE, ContactSpec, wrench_cone_matrix
 from drake_standup.control.terms import RobotTerms
 
 N_BASE = 6  # unactuated floating-base velocities
-DAQP_EQUALITY = 5  # daqp's constraint "sense" flag for an equality row
 SOLVERS = ("daqp", "osqp", "clarabel")
 
 
@@ -74,24 +75,25 @@ class QpLayout:
 
 @dataclass
 class Task:
-    """One least-squares objective, weight * ||A z[columns] - b||^2."""
+    """One least-squares objective, ||A z[columns] - b||^2 weighted by weight (a scalar,
+    or one weight per row of A)."""
 
     name: str
-    weight: float
+    weight: float | np.ndarray
     A: np.ndarray  # (rows, width of columns)
-    b: np.ndarray  # (rows,)
+    b: np.ndarray | None  # (rows,); None for a tracking task (its b comes each tick)
     columns: slice
 
 
 @dataclass
-class ContactCommand:
-    """What the contact plan asks of an active contact this tick."""
+class ContactCommands:
+    """What the contact plan asks of the program's contacts this tick (in its order)."""
 
-    min_normal_force_N: float
-    max_normal_force_N: float
-    # Rows of the spatial acceleration at the hold point, in C ([alpha; a]), that are
-    # held at zero; a constrained contact only.
-    held_rows: np.ndarray = field(default_factory=lambda: np.ones(6, dtype=bool))
+    min_normal_force_N: np.ndarray  # (nc,)
+    max_normal_force_N: np.ndarray  # (nc,)
+    # Constrained contacts that hold only some rows of their hold point's spatial
+    # acceleration, in C ([alpha; a]): contact index -> held rows; the others hold all.
+    partially_held: dict[int, np.ndarray]
 
 
 @dataclass
@@ -102,15 +104,37 @@ class QpSolution:
     ok: bool
     vdot: np.ndarray  # (nv,)
     F_C: np.ndarray  # (nc, 6) each contact's wrench in its frame, [tau; f], N m / N
-    F_W: np.ndarray  # (nc, 6) the same wrenches at each contact frame's origin, in W
     tau: np.ndarray  # (nu,) joint torques, actuator order, N m
     assembly_s: float
     solve_s: float
+    frame_rotations: Callable[[], np.ndarray]  # () -> the contact frames' R_WC (nc, 3, 3)
+
+    @cached_property
+    def F_W(self) -> np.ndarray:
+        """(nc, 6) F_C at each contact frame's origin, in W (computed when asked for: the
+        controller does not need the frames' poses)."""
+        nc = len(self.frames)
+        # [tau; f] in C -> W, all contacts at once: (nc, 3, 3) @ (nc, 3, 2).
+        R_WC = self.frame_rotations()
+        F_W = (R_WC @ self.F_C.reshape(nc, 2, 3).transpose(0, 2, 1)).transpose(0, 2, 1)
+        return F_W.reshape(nc, WRENCH_SIZE)
+
+
+def as_slice(indices: np.ndarray) -> slice | np.ndarray:
+    """indices as a slice when they are consecutive (a view instead of a copy)."""
+    indices = np.asarray(indices)
+    if len(indices) and np.array_equal(indices, np.arange(indices[0], indices[0] + len(indices))):
+        return slice(int(indices[0]), int(indices[0]) + len(indices))
+    return indices
 
 
 class WholeBodyQp:
     """Builds the program of the module docstring once for a set of active contacts;
-    refills and solves it each tick."""
+    refills and solves it each tick.
+
+    Everything that does not depend on the state is filled in once: the cone rows, the
+    regularisation, the fixed tasks' cost and the tracking tasks' Hessian blocks.
+    """
 
     def __init__(
         self,
@@ -122,54 +146,98 @@ class WholeBodyQp:
         wrench_weight: float,
         acceleration_weight: float,
         fixed_tasks: list[Task],
+        tracking_tasks: list[Task] = (),
+        bounded_accelerations: np.ndarray = (),
         solver: str = "daqp",
     ):
-        """fixed_tasks: tasks whose A and b never change, added to the cost once."""
+        """fixed_tasks: tasks whose A and b never change, added to the cost once.
+        tracking_tasks: tasks whose A never changes; solve() takes their b each tick.
+        bounded_accelerations: the entries of vdot that solve() bounds."""
         nv, nu = B.shape
         if not (np.all((B == 0) | (B == 1)) and np.all(B.sum(axis=0) == 1)):
             raise ValueError("the actuation matrix B must select one velocity per actuator")
-        # tau = B^T (...) picks the actuated rows of a generalized force.
-        self._actuated = B.argmax(axis=0)
         self.layout = layout = QpLayout.of(contacts, nv)
         self.contacts = list(contacts)
+        self.frames = [spec.frame for spec in contacts]
+        self._solver = solver
         self._torque_limit_Nm = torque_limit_Nm
         self._torque_weight = torque_weight
-        n, nw = layout.n, layout.n_wrench
+        n, nw, nc = layout.n, layout.n_wrench, len(contacts)
 
-        # Rows of A: dynamics (6), accelerations of the constrained contacts (6 each),
-        # cones (10 per contact), torques (nu). The bound vectors lo, hi hold first the
-        # simple bounds on all n unknowns, then one entry per row of A (daqp's layout);
-        # _bounds(rows) maps rows of A to their entries.
-        self._rows_dyn = slice(0, N_BASE)
-        self._rows_acc: dict[int, slice] = {}
-        row = N_BASE
-        for c, spec in enumerate(contacts):
-            if spec.constrained:
-                self._rows_acc[c] = slice(row, row + WRENCH_SIZE)
-                row += WRENCH_SIZE
+        # Rows of A: accelerations of the constrained contacts (6 each), cones (10 per
+        # contact), then the rows of (1): the six base rows and, last, the torques (nu),
+        # tau = B^T (...) picking the actuated rows of a generalized force. The bound
+        # vectors lo, hi hold first the simple bounds on all n unknowns, then one entry
+        # per row of A (daqp's layout); _bounds(rows) maps rows of A to their entries.
+        self._held = [c for c, spec in enumerate(contacts) if spec.constrained]
+        rows_acc = slice(0, WRENCH_SIZE * len(self._held))
         cones = [wrench_cone_matrix(spec) for spec in contacts]
+        row = rows_acc.stop
         rows_cones = slice(row, row + sum(len(K) for K in cones))
-        self._rows_tau = slice(rows_cones.stop, rows_cones.stop + nu)
+        rows_dynamics = slice(rows_cones.stop, rows_cones.stop + N_BASE + nu)
+        self._rows_tau = slice(rows_cones.stop + N_BASE, rows_dynamics.stop)
         m = self._rows_tau.stop
-        self._A = np.zeros((m, n))
-        self._lo = np.full(n + m, -np.inf)
-        self._hi = np.full(n + m, np.inf)
-        self._equality = np.zeros(n + m, dtype=bool)
+        self._A = A = np.zeros((m, n))
+        self._lo = lo = np.full(n + m, -np.inf)
+        self._hi = hi = np.full(n + m, np.inf)
+        self._equality = np.zeros(n + m, dtype=np.int32)  # 1: lo == hi is an equality
         for c, K in enumerate(cones):
             cone = slice(row, row + len(K))
             row = cone.stop
-            self._A[cone, layout.wrench(c)] = K
-            self._hi[self._bounds(cone)] = 0.0
-        self._equality[self._bounds(self._rows_dyn)] = True
-        self._hold_points = [np.array(spec.hold_point_m) for spec in contacts]
-        self._T = np.zeros((nu, n))  # tau = T z + t0
+            A[cone, layout.wrench(c)] = K
+            hi[self._bounds(cone)] = 0.0
+        self._equality[self._bounds(slice(rows_dynamics.start, self._rows_tau.start))] = 1
+        # The constrained contacts' rows are equalities (all rows held) until solve() gets
+        # ContactCommands.partially_held: the last one it got.
+        self._equality[self._bounds(rows_acc)] = 1
+        self._partially_held: dict[int, np.ndarray] = {}
+        # Rows of A that the last partially_held leaves free (None: all held).
+        self._free_rows: np.ndarray | None = None
+        # Views of A, lo, hi refilled each tick.
+        self._A_acc = A[rows_acc, layout.vdot]
+        self._lo_acc, self._hi_acc = lo[self._bounds(rows_acc)], hi[self._bounds(rows_acc)]
+        self._A_dynamics_F = A[rows_dynamics, :nw]
+        self._A_dynamics_vdot = A[rows_dynamics, layout.vdot]
+        self._lo_dynamics = lo[self._bounds(rows_dynamics)]
+        self._hi_dynamics = hi[self._bounds(rows_dynamics)]
+        self._T = A[self._rows_tau]  # tau = T z + t0
+        # Rows of a generalized force in the rows of (1); the actuated ones.
+        self._generalized_rows = as_slice(np.r_[np.arange(N_BASE), B.argmax(axis=0)])
+        self._actuated = as_slice(B.argmax(axis=0))
+        # lo, hi of the rows of (1) are r + these, r = tau_hand - h (rows in order).
+        self._dynamics_lo = np.r_[np.zeros(N_BASE), np.full(nu, -torque_limit_Nm)]
+        self._dynamics_hi = -self._dynamics_lo
+        # The unknowns' rows among each contact's 6-D wrench [tau; f] (f_z last): rows of
+        # the contacts' stacked Jacobians (nc * 6, nv); and the normal forces' entries of z.
+        self._unknowns = np.concatenate(
+            [
+                WRENCH_SIZE * c + np.arange(WRENCH_SIZE)[spec.components]
+                for c, spec in enumerate(contacts)
+            ]
+        )
+        self._normal = np.array([layout.wrench(c).stop - 1 for c in range(nc)])
+        self._bounded_vdot = nw + np.asarray(bounded_accelerations, dtype=int)
+        self._GT: np.ndarray | None = None
+        self._GT_terms: RobotTerms | None = None
 
         self._H_fixed = np.diag(
             np.concatenate([np.full(nw, wrench_weight), np.full(nv, acceleration_weight)])
         )
         self._g_fixed = np.zeros(n)
         self._add_tasks(self._H_fixed, self._g_fixed, fixed_tasks)
-        self._backend = make_backend(solver, n, m)
+        self._g_fixed_zero = not self._g_fixed.any()
+        # Tracking tasks: their Hessian blocks now; g[columns] += -(w A^T) b each tick.
+        self._tracking = []
+        for task in tracking_tasks:
+            WA = task.A.T * task.weight
+            self._H_fixed[task.columns, task.columns] += WA @ task.A
+            self._tracking.append((task.columns, -WA))
+        # Without the torque rows (tried first), and with them (module docstring): A, lo,
+        # hi, equality and a backend for each.
+        self._programs = [
+            (A[:rows], lo[: n + rows], hi[: n + rows], self._equality[: n + rows], None)
+            for rows in (self._rows_tau.start, m)
+        ]
 
     def _bounds(self, rows: slice) -> slice:
         """Entries of lo, hi (after the n simple bounds) that belong to rows of A."""
@@ -178,119 +246,148 @@ class WholeBodyQp:
 
     @staticmethod
     def _add_tasks(H: np.ndarray, g: np.ndarray, tasks: list[Task]) -> None:
-        """H += sum w A^T A, g -= sum w A^T b, each on its task's block of columns."""
+        """H += sum A^T W A, g -= sum A^T W b, each on its task's block of columns."""
         for task in tasks:
-            WA = task.weight * task.A.T
+            WA = task.A.T * task.weight
             H[task.columns, task.columns] += WA @ task.A
             g[task.columns] -= WA @ task.b
+
+    def contact_map(self, terms: RobotTerms) -> np.ndarray:
+        """G^T (n_wrench, nv), G_c = J_c^T X_c: the contact unknowns to generalized forces
+        (X_c: the unknowns of contact c to its 6-D wrench at Co, in W): the rows of the
+        contacts' Jacobians expressed in their own frames (control/terms.py) that act on
+        the unknowns. Its first six columns map them to their resultant about the base
+        origin, in W. terms holds the program's contact frames, in its order. Computed
+        once per terms."""
+        if self._GT_terms is not terms:
+            self._GT = terms.J_F.reshape(-1, self.layout.nv)[self._unknowns]
+            self._GT_terms = terms
+        return self._GT
 
     def solve(
         self,
         terms: RobotTerms,
         tasks: list[Task],
-        commands: list[ContactCommand],
-        tau_hand: np.ndarray,
+        targets: list[np.ndarray],
+        commands: ContactCommands,
+        tau_hand: np.ndarray | None,
         vdot_min: np.ndarray,
         vdot_max: np.ndarray,
     ) -> QpSolution:
         """Solves the tick's QP.
 
-        tau_hand = J_h^T F_hand is the hands' generalized force; vdot_min <= vdot <= vdot_max
-        are simple bounds (+-inf where none), e.g. from joint limits.
+        terms: for the program's contact frames (frame_names), in its order. tasks: this
+        tick's tasks (besides the fixed and tracking ones); targets: the tracking tasks' b,
+        in their order. tau_hand = J_h^T F_hand is the hands' generalized force (None: no
+        pull); vdot_min <= vdot <= vdot_max bound the bounded_accelerations (e.g. from
+        joint limits).
         """
         t_start = time.perf_counter()
-        layout, nw, vdot = self.layout, self.layout.n_wrench, self.layout.vdot
-        A, lo, hi, equality, T = self._A, self._lo, self._hi, self._equality, self._T
-        frames = [terms.frames[spec.frame] for spec in self.contacts]
-        # X_c: the contact's unknowns -> its 6-D wrench at Co, in W.
-        X = [frame.X_WF[:, spec.components] for spec, frame in zip(self.contacts, frames)]
+        lo, hi = self._lo, self._hi
+        GT = self.contact_map(terms)
 
-        # G = [G_1 .. G_nc], G_c = J_c^T X_c: contact wrenches -> generalized forces.
-        G = np.hstack([frame.J_WF.T @ X_c for frame, X_c in zip(frames, X)])
+        # (1) and (2), rows [-G, M] z in [r + lo, r + hi], r = tau_hand - h.
+        rows = self._generalized_rows
+        np.negative(GT.T[rows], out=self._A_dynamics_F)
+        self._A_dynamics_vdot[:] = terms.M[rows]
+        r = np.negative(terms.h) if tau_hand is None else tau_hand - terms.h
+        np.add(r[rows], self._dynamics_lo, out=self._lo_dynamics)
+        np.add(r[rows], self._dynamics_hi, out=self._hi_dynamics)
 
-        # (1), base rows: [-G_f, M_f] z = S_f (tau_hand - h).
-        A[self._rows_dyn, :nw] = -G[:N_BASE]
-        A[self._rows_dyn, vdot] = terms.M[:N_BASE]
-        dyn = self._bounds(self._rows_dyn)
-        lo[dyn] = hi[dyn] = tau_hand[:N_BASE] - terms.h[:N_BASE]
+        # Held contacts: the held rows of J_CP vdot = -Jdot_CP v, expressed in C.
+        self._A_acc[:] = terms.J_P.reshape(self._A_acc.shape)
+        np.negative(terms.Jdotv_P.reshape(-1), out=self._lo_acc)
+        self._hi_acc[:] = self._lo_acc
+        if commands.partially_held is not self._partially_held:
+            self._partially_held = commands.partially_held
+            free = [
+                WRENCH_SIZE * self._held.index(c) + np.flatnonzero(~held)
+                for c, held in commands.partially_held.items()
+            ]
+            self._free_rows = np.concatenate(free) if free else None
+            self._equality[self._bounds(slice(0, len(self._lo_acc)))] = 1
+            if self._free_rows is not None:
+                self._equality[self.layout.n + self._free_rows] = 0
+        if self._free_rows is not None:
+            self._lo_acc[self._free_rows] = -np.inf
+            self._hi_acc[self._free_rows] = np.inf
+        # Normal forces (f_z comes last in F_c) and accelerations.
+        lo[self._normal] = commands.min_normal_force_N
+        hi[self._normal] = commands.max_normal_force_N
+        lo[self._bounded_vdot] = vdot_min
+        hi[self._bounded_vdot] = vdot_max
 
-        # Contacts: held rows of J_CP vdot = -Jdot_CP v; normal-force bounds (f_z comes
-        # last in F_c).
-        for c, (frame, command) in enumerate(zip(frames, commands, strict=True)):
-            if c in self._rows_acc:
-                rows = self._rows_acc[c]
-                acc = self._bounds(rows)
-                held = command.held_rows
-                equality[acc] = held
-                J_WP, bias_WP = held_point_terms(frame, terms.v, self._hold_points[c])
-                if held.all():  # all six rows: the frame they are expressed in is moot
-                    A[rows, vdot] = J_WP
-                    lo[acc] = hi[acc] = -bias_WP
-                else:  # some rows of C only
-                    X_CW = frame.X_WF.T
-                    A[rows, vdot] = X_CW @ J_WP
-                    rhs = -(X_CW @ bias_WP)
-                    lo[acc] = np.where(held, rhs, -np.inf)
-                    hi[acc] = np.where(held, rhs, np.inf)
-            normal = layout.wrench(c).stop - 1
-            lo[normal] = command.min_normal_force_N
-            hi[normal] = command.max_normal_force_N
-        lo[vdot], hi[vdot] = vdot_min, vdot_max
-
-        # (2): tau = T z + t0 within the limits.
-        T[:, :nw] = -G[self._actuated]
-        T[:, vdot] = terms.M[self._actuated]
-        t0 = terms.h[self._actuated] - tau_hand[self._actuated]
-        A[self._rows_tau] = T
-        tau_bounds = self._bounds(self._rows_tau)
-        lo[tau_bounds] = -self._torque_limit_Nm - t0
-        hi[tau_bounds] = self._torque_limit_Nm - t0
-
+        # Cost: w_tau ||T z + t0||^2 with t0 = -r[actuated], the tasks, the fixed part.
+        T = self._T
+        r_actuated = r[self._actuated]
         WT = self._torque_weight * T.T
-        H = self._H_fixed + WT @ T
-        g = self._g_fixed + WT @ t0
+        H = WT @ T
+        H += self._H_fixed
+        g = WT @ r_actuated
+        np.negative(g, out=g)
+        if not self._g_fixed_zero:
+            g += self._g_fixed
         self._add_tasks(H, g, tasks)
+        for (columns, minus_WA), b in zip(self._tracking, targets, strict=True):
+            g[columns] += minus_WA @ b
         t_assembled = time.perf_counter()
 
-        z, ok = self._backend.solve(H, g, A, lo, hi, equality)
+        # Without the torque rows first (module docstring).
+        for k, (A, lo_k, hi_k, equality, backend) in enumerate(self._programs):
+            if backend is None:
+                backend = make_backend(self._solver, *A.shape[::-1])
+                self._programs[k] = A, lo_k, hi_k, equality, backend
+            z, ok = backend.solve(H, g, A, lo_k, hi_k, equality)
+            tau = T @ z
+            tau -= r_actuated
+            if not ok or np.abs(tau).max() <= self._torque_limit_Nm:
+                break
         t_solved = time.perf_counter()
-        ok = ok and bool(np.all(np.isfinite(z)))
-        F_C = np.zeros((len(self.contacts), WRENCH_SIZE))
-        for c, spec in enumerate(self.contacts):
-            F_C[c, spec.components] = z[layout.wrench(c)]
+        ok = ok and bool(np.isfinite(z).all())
+        nc, nw = len(self.contacts), self.layout.n_wrench
+        F_C = np.zeros((nc, WRENCH_SIZE))
+        F_C.reshape(-1)[self._unknowns] = z[:nw]
         return QpSolution(
-            frames=[spec.frame for spec in self.contacts],
+            frames=list(self.frames),
             ok=ok,
-            vdot=z[vdot],
+            vdot=z[nw:],
             F_C=F_C,
-            F_W=np.array([frame.X_WF @ F for frame, F in zip(frames, F_C, strict=True)]),
-            tau=T @ z + t0,
+            tau=tau,
             assembly_s=t_assembled - t_start,
             solve_s=t_solved - t_assembled,
+            frame_rotations=terms.frame_rotations,
         )
 
 
 # --- Solver backends ------------------------------------------------------------------
 # Each solves  min 0.5 z^T H z + g^T z  s.t.  lo[:n] <= z <= hi[:n],
-# lo[n:] <= A z <= hi[n:], with equality[i] marking the entries where lo[i] == hi[i].
+# lo[n:] <= A z <= hi[n:], with equality[i] (1 or 0) marking the entries where
+# lo[i] == hi[i].
 
 
 def make_backend(solver: str, n: int, m: int):
     if solver == "daqp":
-        return DaqpBackend()
+        return DaqpBackend(n + m)
     if solver in ("osqp", "clarabel"):
         return DrakeBackend(solver, n, m)
     raise ValueError(f"controller.qp_solver: '{solver}'; accepted: {', '.join(SOLVERS)}")
 
 
 class DaqpBackend:
-    """daqp (dense active-set). Solved cold each tick: its Model.update + warm-started
-    solve measured slower here (178 us) than a cold solve (154 us), whose cost is the
-    set-up (factorising H) rather than the 1-5 active-set iterations."""
+    """daqp (dense active-set), solved cold each tick. Its cost is the set-up (factorising
+    H, A R^-1), not the 1-15 active-set iterations: neither its Model API (which redoes
+    the set-up on any update of H or A) nor a hot start from the last active set (sense
+    flags: 5 iterations down to 1) nor handing it an identity Hessian after a Cholesky and
+    triangular solve in LAPACK paid in the closed loop (measured)."""
+
+    EQUALITY = 5  # sense flags: ACTIVE (1) | IMMUTABLE (4)
+
+    def __init__(self, size: int):
+        self._sense = np.zeros(size, dtype=np.int32)
 
     def solve(self, H, g, A, lo, hi, equality) -> tuple[np.ndarray, bool]:
-        sense = np.where(equality, DAQP_EQUALITY, 0).astype(np.int32)
-        z, _, exitflag, _ = daqp.solve(H, g, A, hi, lo, sense)
+        np.multiply(equality, self.EQUALITY, out=self._sense)
+        z, _, exitflag, _ = daqp.solve(H, g, A, hi, lo, self._sense)
         return np.asarray(z), exitflag >= 1
 
 

@@ -20,12 +20,13 @@ end the whole pull is compensated, and as the CoM runs ahead of its reference:
     u = xd_dot / ||xd_dot||,  lead = (x - x_d) . u,  s = smoothstep (3 r^2 - 2 r^3 on [0, 1]).
 """
 
+import math
+
 import numpy as np
 
 from drake_standup.control.contacts import ContactSpec
 from drake_standup.control.qp import QpLayout, Task
-from drake_standup.control.spatial import rotation_vector, skew
-from drake_standup.control.terms import RobotTerms
+from drake_standup.control.spatial import cross, rotation_vector, skew
 
 
 def com_acceleration_reference(
@@ -61,7 +62,7 @@ def helpful_force(
     the help fades out (smoothstep) between a lead of 0 and max_lead_m, so that with psi
     not advancing (or at its upper bound) a pull cannot carry the CoM past the reference.
     """
-    speed = float(np.linalg.norm(xd_dot))
+    speed = math.sqrt(float(xd_dot @ xd_dot))
     if speed == 0.0:
         return np.zeros(3)
     u = xd_dot / speed
@@ -69,42 +70,31 @@ def helpful_force(
     return fade * max(float(f_hand_W @ u), 0.0) * u
 
 
-def hand_wrench_about_com(
-    terms: RobotTerms, hand_frames: list[str], F_hand_W: np.ndarray
-) -> np.ndarray:
-    """W_hand,Com (6,): the hands' wrenches [tau; f] (each at its frame's origin, in W)
-    shifted to the CoM and summed."""
-    total = np.zeros(6)
-    for k, name in enumerate(hand_frames):
-        tau_W, f_W = F_hand_W[6 * k : 6 * k + 3], F_hand_W[6 * k + 3 : 6 * k + 6]
-        total[:3] += tau_W + skew(terms.frames[name].p_WF - terms.p_WCom) @ f_W
-        total[3:] += f_W
-    return total
-
-
 def momentum_task(
-    terms: RobotTerms,
     layout: QpLayout,
-    contacts: list[ContactSpec],
+    G_T: np.ndarray,
+    p_BoCom: np.ndarray,
     Ldot_target: np.ndarray,
-    W_hand_Com: np.ndarray,
-    gravity_W: np.ndarray,
+    W_hand_Bo: np.ndarray | None,
+    W_gravity: np.ndarray,
     weight: float,
 ) -> Task:
-    """sum_c X_Com,c F_c = Ldot_target - [0; m g] - W_hand_Com (module docstring),
-    X_Com,c = [R, (p_C - p_Com) x R; 0, R] (R = R_WC) mapping [tau_C; f_C] to the wrench
-    about the CoM in W (its force columns only for a point contact).
+    """sum_c X_Com,c F_c = Ldot_target - [0; m g] - W_hand_Com (module docstring;
+    W_gravity = [0; m g]), with X_Com,c = [R, (p_C - p_Com) x R; 0, R] (R = R_WC) mapping
+    [tau_C; f_C] to the wrench about the CoM in W (its force columns only for a point
+    contact).
+
+    The first six columns of G^T (control/qp.py: WholeBodyQp.contact_map) map the contact
+    unknowns to their resultant wrench about the base origin Bo in W, and W_hand_Bo (the
+    first six entries of J_h^T F_hand; None: no pull) is the hands' resultant there
+    (control/terms.py); about the CoM, W_Com = [W_ang - p_BoCom x W_lin; W_lin].
     """
-    A = np.zeros((6, layout.n_wrench))
-    for c, spec in enumerate(contacts):
-        frame = terms.frames[spec.frame]
-        force = slice(layout.wrench(c).stop - 3, layout.wrench(c).stop)
-        if not spec.point:
-            A[:3, force.start - 3 : force.start] = frame.R_WF
-        A[:3, force] = skew(frame.p_WF - terms.p_WCom) @ frame.R_WF
-        A[3:, force] = frame.R_WF
-    gravity_wrench = np.concatenate([np.zeros(3), terms.mass_kg * gravity_W])
-    b = Ldot_target - gravity_wrench - W_hand_Com
+    A = G_T[:, :6].T.copy()
+    A[:3] -= skew(p_BoCom) @ A[3:]
+    b = Ldot_target - W_gravity
+    if W_hand_Bo is not None:
+        b -= W_hand_Bo
+        b[:3] += cross(p_BoCom, W_hand_Bo[3:])
     return Task("momentum", weight, A, b, layout.wrenches)
 
 
@@ -123,39 +113,45 @@ def cop_centering_task(layout: QpLayout, contacts: list[ContactSpec], weight: fl
     return Task("cop_centering", weight, A, np.zeros(len(A)), layout.wrenches)
 
 
-def posture_task(
-    layout: QpLayout,
-    v_indices: np.ndarray,
-    qddot_target: np.ndarray,
-    weights: np.ndarray,
-) -> Task:
-    """vdot[v_indices] = qddot_target: joint accelerations in actuator order, each row
-    weighted by weights (a row scaled by sqrt(w_i) in a unit-weight task). The task spans
-    only the block of columns from the first to the last joint rate."""
+def posture_task(layout: QpLayout, v_indices: np.ndarray, weights: np.ndarray) -> Task:
+    """vdot[v_indices] = qddot*: joint accelerations in actuator order, row i weighted by
+    weights[i]; a tracking task (b = qddot*, see posture_acceleration_reference). The task
+    spans only the block of columns from the first to the last joint rate."""
     first, last = int(v_indices.min()), int(v_indices.max())
-    sqrt_w = np.sqrt(weights)
     A = np.zeros((len(v_indices), last - first + 1))
-    A[np.arange(len(v_indices)), v_indices - first] = sqrt_w
+    A[np.arange(len(v_indices)), v_indices - first] = 1.0
     columns = slice(layout.vdot.start + first, layout.vdot.start + last + 1)
-    return Task("posture", 1.0, A, sqrt_w * qddot_target, columns)
+    return Task("posture", np.asarray(weights, dtype=float), A, None, columns)
 
 
-def base_orientation_task(
-    terms: RobotTerms,
-    layout: QpLayout,
+def posture_acceleration_reference(
+    q: np.ndarray, qdot: np.ndarray, q_reference: np.ndarray, kp_per_s2: float, kd_per_s: float
+) -> np.ndarray:
+    """qddot* = -K_P (q - q_ref) - K_D qdot, rad/s^2."""
+    return -kp_per_s2 * (q - q_reference) - kd_per_s * qdot
+
+
+def base_orientation_task(layout: QpLayout, weight: float) -> Task:
+    """wdot_WB = wdot*: the base's angular acceleration, a tracking task (b = wdot*, see
+    base_orientation_reference). The base comes first in v: vdot[:3] = wdot_WB
+    (control/terms.py)."""
+    base = slice(layout.vdot.start, layout.vdot.start + 3)
+    return Task("base_orientation", weight, np.eye(3), None, base)
+
+
+def base_orientation_reference(
+    R_WB: np.ndarray,
+    w_WB: np.ndarray,
     R_WB_target: np.ndarray,
     kp_per_s2: float,
     kd_per_s: float,
-    weight: float,
-) -> Task:
-    """wdot_WB = -K_P theta k - K_D w_WB, with theta k the rotation from target to R_WB.
-
-    The base comes first in v: vdot[:3] = wdot_WB, v[:3] = w_WB (control/terms.py).
-    """
-    error = rotation_vector(terms.R_WB @ R_WB_target.T)
-    w_WB = terms.v[:3]
-    base = slice(layout.vdot.start, layout.vdot.start + 3)
-    return Task("base_orientation", weight, np.eye(3), -kp_per_s2 * error - kd_per_s * w_WB, base)
+) -> np.ndarray:
+    """wdot* = -K_P theta k - K_D w_WB, rad/s^2, with theta k the rotation from target to
+    R_WB."""
+    wdot = rotation_vector(R_WB @ R_WB_target.T)
+    wdot *= -kp_per_s2
+    wdot -= kd_per_s * w_WB
+    return wdot
 
 
 def joint_limit_acceleration_bounds(
@@ -170,7 +166,5 @@ def joint_limit_acceleration_bounds(
 
     2 (q_min - q - T qdot) / T^2 <= qddot <= 2 (q_max - q - T qdot) / T^2."""
     scale = 2.0 / horizon_s**2
-    return (
-        scale * (q_min - q - horizon_s * qdot),
-        scale * (q_max - q - horizon_s * qdot),
-    )
+    q_coasting = q + horizon_s * qdot
+    return scale * (q_min - q_coasting), scale * (q_max - q_coasting)
