@@ -50,7 +50,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import DEFAULT_SCENARIO, Scenario, ScenarioError, load_scenario
 from drake_standup.controller import WholeBodyController
-from drake_standup.diagram import build_diagram
+from drake_standup.diagram import add_seat_hold, build_diagram
 from drake_standup.scene import add_scene, set_seated_state
 from drake_standup.simulate import RunResult, simulate
 
@@ -131,14 +131,7 @@ def _tick_split(results: list[RunResult]) -> dict:
     timing = np.concatenate([r.controller_timing_s for r in results])
     columns = [name.removesuffix("_s") + "_us" for name in WholeBodyController.TIMING]
     us = 1e6 * timing
-    split = {
-        name: {
-            "median": float(np.median(us[:, k])),
-            "p95": float(np.percentile(us[:, k], 95)),
-            "mean": float(us[:, k].mean()),
-        }
-        for k, name in enumerate(columns)
-    }
+    split = {name: _us_stats(us[:, k]) for k, name in enumerate(columns)}
     # The parts are disjoint intervals inside the tick: what they leave of the
     # total is the rest of the update (posture, state writes).
     parts = us[:, :-1].sum(axis=1)
@@ -163,14 +156,16 @@ def _step_times_s(simulator: Simulator, step_s: float, steps: int) -> list[float
     return times
 
 
-def _step_stats(times_s: list[float]) -> dict:
-    us = 1e6 * np.asarray(times_s)
+def _us_stats(us: np.ndarray) -> dict:
     return {
         "median": float(np.median(us)),
         "p95": float(np.percentile(us, 95)),
         "mean": float(us.mean()),
-        "steps": len(us),
     }
+
+
+def _step_stats(times_s: list[float]) -> dict:
+    return _us_stats(1e6 * np.asarray(times_s)) | {"steps": len(times_s)}
 
 
 def _plant_step(scenario: Scenario, steps: int) -> dict:
@@ -181,19 +176,11 @@ def _plant_step(scenario: Scenario, steps: int) -> dict:
     builder = DiagramBuilder()
     hold = scenario.seat_hold
     scene = add_scene(builder, scenario, pd_gains=(hold.kp_Nm_per_rad, hold.kd_Nms_per_rad))
+    add_seat_hold(builder, scene, scenario)
     simulator = Simulator(builder.Build())
     ApplySimulatorConfig(scenario.simulator, simulator)
-    plant, instance = scene.plant, scene.robot.model_instance
-    plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
-    set_seated_state(scene, plant_context, scenario)
-    actuators = [plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(instance)]
-    q_desired = [actuator.joint().GetOnePosition(plant_context) for actuator in actuators]
-    plant.get_desired_state_input_port(instance).FixValue(
-        plant_context, np.concatenate([q_desired, np.zeros(len(actuators))])
-    )
-    tau_g = plant.CalcGravityGeneralizedForces(plant_context)
-    plant.get_actuation_input_port(instance).FixValue(
-        plant_context, plant.MakeActuationMatrix().T @ -tau_g
+    set_seated_state(
+        scene, scene.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()), scenario
     )
     plant_only = _step_times_s(simulator, step_s, steps)
 

@@ -61,7 +61,7 @@ def build_diagram(
     plant = scene.plant
     instance = scene.robot.model_instance
     if controller == "seat_hold":
-        _add_seat_hold(builder, scene, scenario)
+        add_seat_hold(builder, scene, scenario)
 
     # Group names as metrics.json reports them (plural where there are two).
     group_labels = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
@@ -179,7 +179,7 @@ def build_diagram(
     )
 
 
-def _add_seat_hold(builder: DiagramBuilder, scene: Scene, scenario: Scenario) -> None:
+def add_seat_hold(builder: DiagramBuilder, scene: Scene, scenario: Scenario) -> None:
     """Drake's implicit joint PD toward the seated pose plus constant gravity
     feed-forward evaluated at that pose (the chair carries the base)."""
     plant = scene.plant

@@ -14,8 +14,6 @@ from pydrake.systems.framework import BasicVector, Context, LeafSystem
 from drake_standup.caching import declare_cached
 from drake_standup.robot import Robot
 
-HANDS = ("l_hand", "r_hand")
-
 
 def heel_points(robot: Robot) -> dict[str, np.ndarray]:
     """Sole frame -> the middle of its pad's rear bottom edge, in that frame."""

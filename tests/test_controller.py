@@ -390,21 +390,26 @@ def test_failed_qp_keeps_last_torques_and_counts(scene):
     assert diagnostics["qp_ok"] == 0.0 and diagnostics["qp_failures"] == 4.0
 
 
+def _solve_with(scene, solvers, *, seed, **config):
+    """One state-2 tick on a random state (CoM reference at the CoM, at rest),
+    solved by each named QP solver; their solutions in that order."""
+    scene, x0 = scene
+    plant, instance = scene.plant, scene.robot.model_instance
+    x = _random_state(plant, instance, x0, np.random.default_rng(seed))
+    com = _com(plant, instance, x)
+    solutions = []
+    for name in solvers:
+        controller, context = _controller(scene, qp_solver=name, **config)
+        _fix_inputs(controller, context, x, np.concatenate([com, np.zeros(6)]), [2, 1, 1])
+        solutions.append(controller.CalcTick(context).solution)
+    return solutions
+
+
 @pytest.mark.parametrize("solver", ["clarabel", "osqp"])
 def test_drake_solvers_agree_with_daqp(scene, solver):
     """The same tick on a random state, solved by daqp and by Drake's Clarabel / OSQP:
     the same torques and contact wrenches."""
-    scene, x0 = scene
-    plant, robot = scene.plant, scene.robot
-    instance = robot.model_instance
-    x = _random_state(plant, instance, x0, np.random.default_rng(8))
-    com = _com(plant, instance, x)
-    solutions = []
-    for name in ("daqp", solver):
-        controller, context = _controller(scene, qp_solver=name)
-        _fix_inputs(controller, context, x, np.concatenate([com, np.zeros(6)]), [2, 1, 1])
-        solutions.append(controller.CalcTick(context).solution)
-    reference, other = solutions
+    reference, other = _solve_with(scene, ("daqp", solver), seed=8)
     assert reference.ok and other.ok
     np.testing.assert_allclose(other.tau, reference.tau, atol=0.05)  # OSQP: first-order
     np.testing.assert_allclose(other.F_W, reference.F_W, atol=1e-1)
@@ -414,17 +419,7 @@ def test_binding_torque_limits(scene):
     """With a 20 N m torque limit on a random state the limits bind (the program tried
     first without them must be solved again with them): |tau| <= 20 N m, some at the
     limit, and Clarabel finds the same torques and wrenches."""
-    scene, x0 = scene
-    plant, robot = scene.plant, scene.robot
-    instance = robot.model_instance
-    x = _random_state(plant, instance, x0, np.random.default_rng(11))
-    com = _com(plant, instance, x)
-    solutions = []
-    for name in ("daqp", "clarabel"):
-        controller, context = _controller(scene, qp_solver=name, torque_limit_Nm=20.0)
-        _fix_inputs(controller, context, x, np.concatenate([com, np.zeros(6)]), [2, 1, 1])
-        solutions.append(controller.CalcTick(context).solution)
-    reference, other = solutions
+    reference, other = _solve_with(scene, ("daqp", "clarabel"), seed=11, torque_limit_Nm=20.0)
     assert reference.ok and other.ok
     assert np.abs(reference.tau).max() <= 20.0 + 1e-6
     assert np.abs(reference.tau).max() >= 20.0 - 1e-6
