@@ -7,6 +7,7 @@ scenarios/ override what they name.
 """
 
 import math
+import re
 import typing
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -224,6 +225,45 @@ class FallConfig:
 
 
 @dataclass
+class Push:
+    """A push on one robot body: a constant world force over a time window."""
+
+    # A body of the robot; the torso's upper body is 'chest'.
+    body: str = "chest"
+    start_s: float = 5.0
+    duration_s: float = 0.2
+    # World frame, at the body's origin; the robot faces +x, z is up. N.
+    force_N: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+@dataclass
+class PerturbationConfig:
+    """Disturbances and model errors for robustness studies; all off by default.
+
+    The model errors act on the simulated robot only: the controller, the
+    sensing and the human keep the nominal model, as on a real robot whose
+    model is wrong.
+    """
+
+    pushes: list[Push] = field(default_factory=list)
+    # Every body's mass and rotational inertia of the simulated robot times
+    # this factor (CoM locations unchanged).
+    mass_scale: float = 1.0
+    # Every contact geometry's Coulomb friction (pads, chair, floor) times this
+    # factor, so the combined coefficient of each pair scales by it too; the
+    # controller's friction pyramid keeps its nominal mu.
+    friction_scale: float = 1.0
+    # Standard deviation of white noise on each force component of the
+    # measured hand wrenches (what sensing, the state machine and the
+    # controller see; the plant gets the true pull). N.
+    hand_wrench_noise_N: float = 0.0
+    # The noise is held for this long: the wrist sensor's sample period. s.
+    hand_wrench_noise_period_s: float = 0.01
+    # Seed of the noise: the same seed gives the same noise.
+    noise_seed: int = 0
+
+
+@dataclass
 class VisualizationConfig:
     # Meshcat recording frame period; 30 fps keeps a 15 s HTML small. s.
     publish_period_s: float = 1.0 / 30.0
@@ -276,6 +316,8 @@ class Scenario:
     chair: ChairConfig = field(default_factory=ChairConfig)
     seat_hold: SeatHoldConfig = field(default_factory=SeatHoldConfig)
     fall: FallConfig = field(default_factory=FallConfig)
+    # Pushes, model errors and sensor noise (robustness sweeps).
+    perturbation: PerturbationConfig = field(default_factory=PerturbationConfig)
     visualization: VisualizationConfig = field(default_factory=VisualizationConfig)
     # Period of the signal loggers used by metrics and figures. s.
     log_period_s: float = 0.01
@@ -289,19 +331,153 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
         raise ScenarioError(
             f"scenario: file '{path}' not found; accepted: a YAML file, e.g. {', '.join(shipped)}"
         )
+    return parse_scenario(path.read_text(), str(path))
+
+
+def parse_scenario(text: str, where: str = "scenario") -> Scenario:
+    """A scenario from YAML text (where: its name in error messages)."""
     try:
-        raw = yaml.safe_load(path.read_text())
+        raw = yaml.safe_load(text)
     except yaml.YAMLError as err:
-        raise ScenarioError(f"scenario {path}: not valid YAML ({_one_line(err)})") from None
+        raise ScenarioError(f"scenario {where}: not valid YAML ({_one_line(err)})") from None
     if raw is None:
         raw = {}
     _check_schema("", raw, Scenario)
     try:
-        scenario = yaml_load_typed(schema=Scenario, filename=str(path))
+        scenario = yaml_load_typed(schema=Scenario, data=text) if raw else Scenario()
     except (RuntimeError, ValueError, TypeError) as err:
-        raise ScenarioError(f"scenario {path}: {_one_line(err)}") from None
+        raise ScenarioError(f"scenario {where}: {_one_line(err)}") from None
     validate(scenario)
     return scenario
+
+
+# --- Key paths: 'human.pulls[0].force_N[0]', 'advancement.psi_dot_upper' -------
+
+_SEGMENT = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[(?:\d+|\*)\])*)$")
+
+
+def _parse_key_path(path: str) -> list[str | int]:
+    """'a.b[0][*]' -> ['a', 'b', 0, '*']."""
+    steps: list[str | int] = []
+    for part in path.split("."):
+        match = _SEGMENT.match(part.strip())
+        if match is None:
+            raise ScenarioError(
+                f"key path '{path}': '{part}' is not a key; accepted: names joined by '.', "
+                "each with optional [index] or [*], e.g. human.pulls[0].force_N[0]"
+            )
+        steps.append(match.group(1))
+        steps += ["*" if i == "*" else int(i) for i in re.findall(r"\[(\d+|\*)\]", match.group(2))]
+    return steps
+
+
+def _format_key_path(steps: list[str | int]) -> str:
+    out = ""
+    for step in steps:
+        out += f"[{step}]" if isinstance(step, int) or step == "*" else f".{step}"
+    return out.lstrip(".")
+
+
+def expand_key_path(scenario: Scenario, path: str) -> list[str]:
+    """The concrete key paths a path names in scenario ([*]: every element)."""
+    steps = _parse_key_path(path)
+    found: list[list[str | int]] = []
+
+    def walk(obj, schema, done: list, rest: list) -> None:
+        if not rest:
+            found.append(done)
+            return
+        step, rest = rest[0], rest[1:]
+        where = _format_key_path(done) or "scenario"
+        if isinstance(step, str) and step != "*":
+            fields = _fields(schema)
+            if fields is not None:
+                if step not in fields:
+                    raise ScenarioError(
+                        f"key path '{path}': {where} has no key '{step}'; "
+                        f"accepted: {', '.join(fields)}"
+                    )
+                walk(getattr(obj, step), fields[step], done + [step], rest)
+            elif isinstance(obj, dict):
+                if step not in obj:
+                    raise ScenarioError(
+                        f"key path '{path}': {where} has no key '{step}'; "
+                        f"accepted: {', '.join(obj)}"
+                    )
+                walk(obj[step], typing.get_args(schema)[1], done + [step], rest)
+            else:
+                raise ScenarioError(f"key path '{path}': {where} is a value, not a mapping")
+            return
+        if not isinstance(obj, list):
+            raise ScenarioError(f"key path '{path}': {where} is not a list")
+        indices = range(len(obj)) if step == "*" else [step]
+        for i in indices:
+            if i >= len(obj):
+                raise ScenarioError(
+                    f"key path '{path}': index {i} out of range; {where} has {len(obj)} entries"
+                )
+            walk(obj[i], typing.get_args(schema)[0], done + [i], rest)
+
+    walk(scenario, Scenario, [], steps)
+    return [_format_key_path(s) for s in found]
+
+
+def set_key_path(scenario: Scenario, path: str, value) -> None:
+    """Sets one concrete key path (no [*]) to value, type-checked as in a file.
+
+    A mapping for a dataclass-valued key builds that dataclass (its defaults
+    for what the mapping leaves out); a list of mappings, a list of them.
+    """
+    steps = _parse_key_path(path)
+    if "*" in steps:
+        raise ScenarioError(f"key path '{path}': [*] names several keys; set them one by one")
+    parent, schema = scenario, Scenario
+    for depth, step in enumerate(steps):
+        where = _format_key_path(steps[: depth + 1])
+        if isinstance(step, str):
+            fields = _fields(type(parent)) if not isinstance(parent, dict) else None
+            if fields is not None:
+                if step not in fields:
+                    raise ScenarioError(
+                        f"key path '{path}': no key '{step}'; accepted: {', '.join(fields)}"
+                    )
+                schema = fields[step]
+                current = getattr(parent, step)
+            elif isinstance(parent, dict):
+                schema = typing.get_args(schema)[1]
+                current = parent.get(step)
+            else:
+                raise ScenarioError(f"key path '{path}': not a mapping before '{step}'")
+        else:
+            if not isinstance(parent, list) or step >= len(parent):
+                n = len(parent) if isinstance(parent, list) else 0
+                raise ScenarioError(f"key path '{path}': index {step} out of range ({n} entries)")
+            schema = typing.get_args(schema)[0]
+            current = parent[step]
+        if depth == len(steps) - 1:
+            _check_schema(where, value, schema)
+            new = _typed(schema, value)
+            if isinstance(step, int) or isinstance(parent, dict):
+                parent[step] = new
+            else:
+                setattr(parent, step, new)
+            return
+        parent = current
+
+
+def _typed(schema, value):
+    """value (plain YAML data, already schema-checked) as an object of schema."""
+    fields = _fields(schema)
+    if fields is not None and isinstance(value, dict):
+        obj = schema()
+        for key, item in value.items():
+            setattr(obj, key, _typed(fields[key], item))
+        return obj
+    if typing.get_origin(schema) is list:
+        return [_typed(typing.get_args(schema)[0], v) for v in value]
+    if schema is float and isinstance(value, int):
+        return float(value)
+    return value
 
 
 def _one_line(err: Exception) -> str:
@@ -409,6 +585,7 @@ def validate(scenario: Scenario) -> None:
     _validate_human(scenario.human)
     _validate_advancement(scenario.advancement)
     _validate_standup(scenario.standup)
+    _validate_perturbation(scenario.perturbation)
 
 
 def _resolve(path: str) -> Path:
@@ -486,3 +663,19 @@ def _positive(key: str, value: float, allow_zero: bool = False) -> None:
     if not (value >= 0 if allow_zero else value > 0):
         accepted = "a number >= 0" if allow_zero else "a number > 0"
         raise ScenarioError(f"{key}: {value}; accepted: {accepted}")
+
+
+def _validate_perturbation(pert: PerturbationConfig) -> None:
+    for i, push in enumerate(pert.pushes):
+        key = f"perturbation.pushes[{i}]"
+        _positive(f"{key}.start_s", push.start_s, allow_zero=True)
+        _positive(f"{key}.duration_s", push.duration_s)
+        _length(f"{key}.force_N", push.force_N, 3)
+    _positive("perturbation.mass_scale", pert.mass_scale)
+    _positive("perturbation.friction_scale", pert.friction_scale)
+    _positive("perturbation.hand_wrench_noise_N", pert.hand_wrench_noise_N, allow_zero=True)
+    _positive("perturbation.hand_wrench_noise_period_s", pert.hand_wrench_noise_period_s)
+    if pert.noise_seed < 0:
+        raise ScenarioError(
+            f"perturbation.noise_seed: {pert.noise_seed}; accepted: an integer >= 0"
+        )
