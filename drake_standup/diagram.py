@@ -7,7 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.geometry import Meshcat, MeshcatVisualizer, MeshcatVisualizerParams, Role
 from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
-from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.multibody.plant import ExternallyAppliedSpatialForceMultiplexer
+from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
 
 from drake_standup.advancement import TrajectoryAdvancement
@@ -15,6 +16,7 @@ from drake_standup.config import Scenario
 from drake_standup.contacts import ContactForceReporter
 from drake_standup.controller import WholeBodyController
 from drake_standup.human import HumanWrenchSource
+from drake_standup.perturbations import NoisyWrenchSensor, PushSource
 from drake_standup.reference import CoMReferenceGenerator
 from drake_standup.scene import Scene, add_scene, set_seated_state
 from drake_standup.sensing import RobotSensing, heel_points
@@ -93,10 +95,7 @@ def build_diagram(
     )
 
     robot_state = plant.get_state_output_port(instance)
-    hand_wrenches = human.GetOutputPort("hand_wrenches_W")
-    builder.Connect(
-        human.GetOutputPort("spatial_forces"), plant.get_applied_spatial_force_input_port()
-    )
+    pushes, hand_wrenches = _add_perturbations(builder, scene, scenario, human)
     builder.Connect(robot_state, human.GetInputPort("robot_state"))
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
     builder.Connect(hand_wrenches, sensing.GetInputPort("hand_wrenches_W"))
@@ -146,6 +145,8 @@ def build_diagram(
         "segment": state_machine.GetOutputPort("segment"),
         "net_actuation": plant.get_net_actuation_output_port(instance),
     }
+    if pushes is not None:
+        logged["push_force_W"] = pushes.GetOutputPort("push_force_W")
     if controller_system is not None:
         logged["controller_diagnostics"] = controller_system.GetOutputPort("diagnostics")
     logs = {}
@@ -177,6 +178,39 @@ def build_diagram(
     return StandupDiagram(
         diagram, scene, pad_groups, state_machine, advancement, controller_system, logs, visualizer
     )
+
+
+def _add_perturbations(
+    builder: DiagramBuilder, scene: Scene, scenario: Scenario, human: HumanWrenchSource
+) -> tuple[PushSource | None, OutputPort]:
+    """Connects the human's forces to the plant, with the scenario's pushes if
+    any (a multiplexer sums both lists), and returns the push source (or None)
+    and the measured hand wrenches: the human's own, or through the noisy
+    sensor when perturbation.hand_wrench_noise_N > 0. With no perturbation
+    this adds no system."""
+    plant = scene.plant
+    pert = scenario.perturbation
+    human_forces = human.GetOutputPort("spatial_forces")
+    pushes = None
+    if pert.pushes:
+        pushes = builder.AddNamedSystem("pushes", PushSource(plant, scene.robot, pert.pushes))
+        mux = builder.AddNamedSystem("applied_forces", ExternallyAppliedSpatialForceMultiplexer(2))
+        builder.Connect(human_forces, mux.get_input_port(0))
+        builder.Connect(pushes.GetOutputPort("spatial_forces"), mux.get_input_port(1))
+        builder.Connect(mux.get_output_port(), plant.get_applied_spatial_force_input_port())
+    else:
+        builder.Connect(human_forces, plant.get_applied_spatial_force_input_port())
+    hand_wrenches = human.GetOutputPort("hand_wrenches_W")
+    if pert.hand_wrench_noise_N > 0.0:
+        sensor = builder.AddNamedSystem(
+            "hand_wrench_sensor",
+            NoisyWrenchSensor(
+                pert.hand_wrench_noise_N, pert.hand_wrench_noise_period_s, pert.noise_seed
+            ),
+        )
+        builder.Connect(hand_wrenches, sensor.GetInputPort("hand_wrenches_W"))
+        hand_wrenches = sensor.GetOutputPort("hand_wrenches_W")
+    return pushes, hand_wrenches
 
 
 def add_seat_hold(builder: DiagramBuilder, scene: Scene, scenario: Scenario) -> None:

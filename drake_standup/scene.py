@@ -13,6 +13,7 @@ from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.systems.framework import Context, DiagramBuilder
 
 from drake_standup.config import REPO_ROOT, Scenario, _resolve
+from drake_standup.perturbations import scale_friction
 from drake_standup.robot import Robot, add_icub, set_joint_positions
 
 MODELS_DIR = REPO_ROOT / "models"
@@ -65,6 +66,8 @@ def add_scene(
         RigidTransform(scenario.chair.xyz_m),
     )
     plant.Finalize()
+    # Model error of perturbation.friction_scale: every surface, in the model.
+    scale_friction(plant, scene_graph, scenario.perturbation.friction_scale)
 
     # The robot touches the world only through its pads; pads never touch each
     # other (self-collision is not part of this task).

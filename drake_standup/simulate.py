@@ -18,6 +18,7 @@ from pydrake.systems.framework import EventStatus
 from drake_standup import outputs
 from drake_standup.config import Scenario
 from drake_standup.diagram import StandupDiagram, build_diagram
+from drake_standup.perturbations import apply_model_errors
 from drake_standup.progress import ProgressBar
 from drake_standup.scene import set_seated_state
 
@@ -128,6 +129,8 @@ def _simulate_one(
     plant = built.scene.plant
     plant_context = plant.GetMyMutableContextFromRoot(root_context)
     set_seated_state(built.scene, plant_context, scenario)
+    # The simulated robot only: every other system keeps its own nominal context.
+    apply_model_errors(built.scene, plant_context, scenario)
 
     fall = _FallMonitor(built, scenario)
     simulator.set_monitor(fall)
@@ -277,15 +280,19 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
         log = logger.FindLog(root_context)
         signals[name] = (log.sample_times().copy(), log.data().copy())
     result = RunResult({}, signals=signals, pad_groups=dict(built.pad_groups))
+    # The model's (nominal) mass, which the controller knows, and the simulated
+    # one (perturbation.mass_scale), whose weight the contacts carry.
     mass_kg = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
+    simulated_mass_kg = plant.CalcTotalMass(plant.GetMyContextFromRoot(root_context), [instance])
     metrics = outputs.seated_metrics(
         result.times_s,
         result.com_W,
         result.pad_forces_W,
         built.pad_groups,
-        weight_N=mass_kg * GRAVITY_MPS2,
+        weight_N=simulated_mass_kg * GRAVITY_MPS2,
     )
     metrics["robot_mass_kg"] = mass_kg
+    metrics["simulated_mass_kg"] = simulated_mass_kg
     entry_times = built.state_machine.mode(
         built.state_machine.GetMyContextFromRoot(root_context)
     ).entry_times_s
