@@ -13,23 +13,25 @@ from pydrake.geometry import Meshcat
 from pydrake.systems.framework import Diagram
 
 
+def json_safe(x):
+    """x with numpy scalars and arrays as Python values and non-finite floats
+    as None (JSON has no NaN)."""
+    if isinstance(x, dict):
+        return {k: json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple, np.ndarray)):
+        return [json_safe(v) for v in x]
+    if isinstance(x, (float, np.floating)):
+        return float(x) if math.isfinite(x) else None
+    if isinstance(x, np.integer):
+        return int(x)
+    if isinstance(x, np.bool_):
+        return bool(x)
+    return x
+
+
 def write_metrics(path: Path, metrics: dict) -> None:
-    """JSON with non-finite numbers written as null (JSON has no NaN)."""
-
-    def clean(x):
-        if isinstance(x, dict):
-            return {k: clean(v) for k, v in x.items()}
-        if isinstance(x, (list, tuple, np.ndarray)):
-            return [clean(v) for v in x]
-        if isinstance(x, (float, np.floating)):
-            return float(x) if math.isfinite(x) else None
-        if isinstance(x, np.integer):
-            return int(x)
-        if isinstance(x, np.bool_):
-            return bool(x)
-        return x
-
-    path.write_text(json.dumps(clean(metrics), indent=2) + "\n")
+    """JSON with non-finite numbers written as null."""
+    path.write_text(json.dumps(json_safe(metrics), indent=2) + "\n")
 
 
 def write_recording(meshcat: Meshcat, path: Path) -> int:

@@ -24,15 +24,18 @@ class ProgressBar:
         if self.tty:
             filled = int(30 * frac)
             bar = "#" * filled + "." * (30 - filled)
-            self.stream.write(
-                f"\r{self.label} [{bar}] {done:6.2f}/{self.total:.2f} {self.unit} {note}  "
-            )
+            self.stream.write(f"\r{self.label} [{bar}] {self._counts(done)} {note}  ")
             self.stream.flush()
         elif int(10 * frac) > self._last_decile:
             self._last_decile = int(10 * frac)
-            counts = f"({done:.2f}/{self.total:.2f} {self.unit})"
+            counts = f"({self._counts(done)})"
             self.stream.write(f"{self.label}: {100 * frac:3.0f}% {counts} {note}\n")
             self.stream.flush()
+
+    def _counts(self, done: float) -> str:
+        if self.unit == "runs":
+            return f"{int(done)}/{int(self.total)} {self.unit}"
+        return f"{done:6.2f}/{self.total:.2f} {self.unit}"
 
     def close(self) -> None:
         if self.tty:

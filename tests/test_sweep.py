@@ -1,0 +1,301 @@
+"""Sweeps: sweep files, their expansion into runs, Dask runs, resume, tables."""
+
+from __future__ import annotations
+
+import math
+import os
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drake_standup.config import REPO_ROOT, load_scenario, set_key_path
+from drake_standup.sweep import (
+    SweepError,
+    expand,
+    load_sweep,
+    main,
+    read_table,
+    run_one,
+    run_sweep,
+)
+
+# Columns that measure the machine, not the simulation.
+TIMING = ("wall_time_s", "run_wall_s", "realtime_factor", "build_time_s")
+
+
+def _write(tmp_path: Path, text: str, name: str = "sweep.yaml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+GRID = """
+name: g
+base: scenarios/assisted.yaml
+seed: 11
+overrides:
+  duration_s: 0.3
+grid:
+  - name: pull
+    paths: ["human.pulls[*].force_N[0]", "human.pulls[*].force_N[2]"]
+    values: [0, 10, 20]
+  - path: advancement.psi_dot_upper
+    values: [1.5, 2.5]
+"""
+
+
+def test_grid_expands_every_combination_onto_every_named_key(tmp_path):
+    runs = expand(load_sweep(_write(tmp_path, GRID)))
+    assert len(runs) == 3 * 2
+    combos = [(r.params["pull"], r.params["advancement.psi_dot_upper"]) for r in runs]
+    assert combos == [(f, u) for f in (0, 10, 20) for u in (1.5, 2.5)]
+    base = load_scenario(REPO_ROOT / "scenarios/assisted.yaml")
+    for run in runs:
+        paths = dict(run.overrides)
+        # [*] named both pulls; both components x and z are set.
+        for i in (0, 1):
+            for c in (0, 2):
+                assert paths[f"human.pulls[{i}].force_N[{c}]"] == run.params["pull"]
+        assert paths["advancement.psi_dot_upper"] == run.params["advancement.psi_dot_upper"]
+        assert paths["duration_s"] == 0.3
+        # Applied to the base scenario, the overrides give exactly those values.
+        scenario = load_scenario(REPO_ROOT / "scenarios/assisted.yaml")
+        for path, value in run.overrides:
+            set_key_path(scenario, path, value)
+        assert scenario.human.pulls[1].force_N == [run.params["pull"], 0.0, run.params["pull"]]
+        assert scenario.human.pulls[0].hand == base.human.pulls[0].hand
+    assert len({r.run_id for r in runs}) == len(runs)
+
+
+RANDOM = """
+name: r
+base: scenarios/assisted.yaml
+seed: {seed}
+samples: {samples}
+random:
+  - path: advancement.psi_dot_upper
+    draw: {{uniform: [1.0, 3.0]}}
+  - path: robot.model
+    draw: {{choice: [iCubGazeboV2_5, iCubGazeboV2_7]}}
+perturbations:
+  push: {{body: chest, start_s: {{uniform: [3, 7]}}, duration_s: 0.2,
+          magnitude_N: {{uniform: [0, 100]}}, azimuth_deg: {{uniform: [0, 360]}}}}
+  mass_scale: {{normal: [1.0, 0.05]}}
+  hand_wrench_noise_N: 1.5
+"""
+
+
+def test_seeded_random_draws_are_reproducible_and_per_run(tmp_path):
+    def runs(seed, samples):
+        path = _write(tmp_path, RANDOM.format(seed=seed, samples=samples), f"r{seed}{samples}.yaml")
+        return expand(load_sweep(path))
+
+    a, b = runs(5, 40), runs(5, 40)
+    assert [r.overrides for r in a] == [r.overrides for r in b]
+    assert [r.run_id for r in a] == [r.run_id for r in b]
+    # Run k's draws depend on (seed, k) only: a longer sweep starts the same.
+    assert [r.overrides for r in runs(5, 10)] == [r.overrides for r in a[:10]]
+    other = runs(6, 40)
+    assert all(r.params != o.params for r, o in zip(a, other))
+
+    upper = np.array([r.params["advancement.psi_dot_upper"] for r in a])
+    assert upper.min() >= 1.0 and upper.max() <= 3.0 and np.ptp(upper) > 1.0
+    assert {r.params["robot.model"] for r in a} == {"iCubGazeboV2_5", "iCubGazeboV2_7"}
+    for run in a:
+        p = run.params
+        (push,) = dict(run.overrides)["perturbation.pushes"]
+        # The push force is magnitude times the unit vector of the azimuth.
+        az = math.radians(p["push_azimuth_deg"])
+        expected = p["push_magnitude_N"] * np.array([math.cos(az), math.sin(az), 0.0])
+        np.testing.assert_allclose(push["force_N"], expected, atol=1e-12)
+        assert 3 <= push["start_s"] <= 7 and push["duration_s"] == 0.2
+        assert p["hand_wrench_noise_N"] == 1.5
+        assert dict(run.overrides)["perturbation.noise_seed"] >= 0
+    # Distinct noise seeds per run, and mass draws spread like N(1, 0.05).
+    assert len({dict(r.overrides)["perturbation.noise_seed"] for r in a}) == len(a)
+    masses = np.array([r.params["mass_scale"] for r in a])
+    assert abs(masses.mean() - 1.0) < 0.03 and 0.02 < masses.std() < 0.09
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("base: scenarios/nope.yaml\n", "base: 'scenarios/nope.yaml' not found"),
+        ("base: scenarios/assisted.yaml\ngrids: {}\n", "sweep.grids: unknown key"),
+        (
+            "base: scenarios/assisted.yaml\ngrid: {advancement.speed: [1]}\n",
+            "advancement has no key 'speed'",
+        ),
+        (
+            "base: scenarios/assisted.yaml\ngrid: {'human.pulls[4].force_N[0]': [1]}\n",
+            "index 4 out of range",
+        ),
+        (
+            "base: scenarios/seated.yaml\ngrid: {'human.pulls[*].force_N[0]': [1]}\n",
+            "names no key of the base scenario",
+        ),
+        (
+            "base: scenarios/assisted.yaml\ngrid: {advancement.psi_dot_upper: [0.5]}\n",
+            "advancement.psi_dot_upper: 0.5; accepted: a number >= 1",
+        ),
+        (
+            "base: scenarios/assisted.yaml\ngrid: {robot.model: [iCubNope]}\n",
+            "robot.model: unknown model 'iCubNope'",
+        ),
+        (
+            "base: scenarios/assisted.yaml\nrandom: {duration_s: {gauss: [1, 2]}}\n",
+            "{uniform: [low, high]}",
+        ),
+        ("base: scenarios/assisted.yaml\nsamples: 0\n", "samples: 0; accepted"),
+    ],
+)
+def test_bad_sweep_files_fail_with_one_line_naming_the_key(tmp_path, text, message):
+    path = _write(tmp_path, text)
+    with pytest.raises(SweepError) as err:
+        expand(load_sweep(path))
+    assert message in str(err.value)
+    assert "\n" not in str(err.value)
+
+
+def test_cli_bad_input_is_one_error_line_and_exit_2(tmp_path, capsys):
+    assert main([str(tmp_path / "missing.yaml")]) == 2
+    assert main([str(_write(tmp_path, GRID)), "--workers", "0"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and all(line.startswith("error: ") for line in err)
+    assert "missing.yaml' not found" in err[0] and "--workers: 0" in err[1]
+
+
+# Four short runs, one of which fails at once: its fall bound is above the
+# seated root (0.38 m), so the monitor ends it as a fall.
+SMALL = """
+name: small
+base: scenarios/assisted.yaml
+seed: 3
+samples: 2
+overrides:
+  duration_s: 0.25
+grid:
+  - name: min_root_height_m
+    path: fall.min_root_height_m
+    values: [0.1, 0.5]
+random:
+  - name: psi_dot_upper
+    path: advancement.psi_dot_upper
+    draw: {uniform: [1.0, 3.0]}
+perturbations:
+  hand_wrench_noise_N: 1.0
+  push: {body: chest, start_s: 0.1, duration_s: 0.1, magnitude_N: 20.0,
+         azimuth_deg: {uniform: [0, 360]}}
+figures:
+  - {kind: line, x: psi_dot_upper, y: psi_final}
+  - {kind: rate, x: min_root_height_m, y: success, bins: 2}
+"""
+
+
+def _physics(rows: list[dict]) -> list[dict]:
+    return [{k: v for k, v in row.items() if k not in TIMING} for row in rows]
+
+
+def test_small_sweep_on_a_local_cluster_then_resume(tmp_path):
+    spec = load_sweep(_write(tmp_path, SMALL))
+    out = tmp_path / "out"
+    result = run_sweep(spec, out, workers=2, progress=False)
+    assert result.computed == 4
+    rows = read_table(result.table)
+    assert [r["index"] for r in rows] == [0, 1, 2, 3]
+    for row, run in zip(rows, result.runs):
+        assert row["run_id"] == run.run_id
+        assert row["psi_dot_upper"] == pytest.approx(run.params["psi_dot_upper"], rel=1e-12)
+        assert row["sim_time_s"] is not None
+        if row["min_root_height_m"] == 0.5:
+            # Recorded with its reason; the sweep went on.
+            assert row["success"] is False
+            assert row["failure_reason"].startswith("fall: root_link height 0.3")
+            assert row["sim_time_s"] < 0.01
+        else:
+            # 0.25 s seated: not up yet (psi = t before the stand-up starts).
+            assert row["failure_reason"] == "did not stand up"
+            assert row["sim_time_s"] == pytest.approx(0.25)
+            assert row["psi_final"] == pytest.approx(0.25, abs=1e-9)
+    # A worker's run equals the same run simulated here, in this process.
+    direct = run_one(spec.base_text, result.runs[0].overrides)
+    for key in ("com_final_m", "psi_final", "max_abs_torque_Nm", "contact_force_total_N"):
+        got = [v for k, v in rows[0].items() if k == key or k.startswith(key + "[")]
+        want = np.atleast_1d(direct[key])
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+    assert len(result.figures) == 2 and all(p.stat().st_size > 10_000 for p in result.figures)
+
+    # Resume: drop one run's record; only that run is simulated again.
+    records = sorted((out / "runs").glob("*.json"))
+    assert len(records) == 4
+    kept = {p: p.stat().st_mtime_ns for p in records[1:]}
+    records[0].unlink()
+    again = run_sweep(spec, out, workers=1, progress=False)
+    assert again.computed == 1
+    assert all(p.stat().st_mtime_ns == t for p, t in kept.items())
+    assert _physics(read_table(again.table)) == _physics(rows)
+    # Nothing left to do: no cluster is even started.
+    t0 = time.perf_counter()
+    assert run_sweep(spec, out, progress=False).computed == 0
+    assert time.perf_counter() - t0 < 5
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.slow
+def test_explicit_scheduler_at_an_address_gives_the_same_table(tmp_path):
+    """A real cluster of one machine: `dask scheduler` and `dask worker`
+    processes on localhost, reached by address; same table as LocalCluster."""
+    spec_path = _write(tmp_path, SMALL)
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+    worker = [sys.executable, "-m", "distributed.cli.dask_worker"]
+    env = dict(os.environ)
+    procs = [
+        subprocess.Popen(
+            dask + ["--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+    ]
+    try:
+        time.sleep(2.0)
+        procs.append(
+            subprocess.Popen(
+                worker
+                + [
+                    address,
+                    "--nworkers",
+                    "2",
+                    "--nthreads",
+                    "1",
+                    "--no-dashboard",
+                    "--host",
+                    "127.0.0.1",
+                ],
+                env=env,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+            )
+        )
+        assert main([str(spec_path), "--address", address, "--out", str(tmp_path / "a")]) == 0
+    finally:
+        for proc in reversed(procs):
+            proc.terminate()
+        for proc in procs:
+            proc.wait(timeout=30)
+    assert main([str(spec_path), "--workers", "2", "--out", str(tmp_path / "b")]) == 0
+    a = read_table(tmp_path / "a" / "results.csv")
+    b = read_table(tmp_path / "b" / "results.csv")
+    assert len(a) == 4 and _physics(a) == _physics(b)
