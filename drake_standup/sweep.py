@@ -71,6 +71,7 @@ class Figure:
     y: str
     group: str | None = None
     bins: int = 6
+    range: list[float] | None = None  # rate: the bins' span (default: the data's)
     title: str | None = None
 
 
@@ -246,7 +247,18 @@ def _figure(i: int, entry) -> Figure:
     where = f"figures[{i}]"
     if not isinstance(entry, dict):
         raise SweepError(f"{where}: accepted: a mapping of kind, x, y, group, bins, title")
-    _known(where, entry, ("kind", "x", "y", "group", "bins", "title"))
+    _known(where, entry, ("kind", "x", "y", "group", "bins", "range", "title"))
+    span = entry.get("range")
+    if span is not None and not (
+        isinstance(span, list)
+        and len(span) == 2
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in span)
+        and span[0] < span[1]
+    ):
+        raise SweepError(f"{where}.range: {span!r}; accepted: [low, high] with low < high")
+    bins = entry.get("bins", 6)
+    if not isinstance(bins, int) or isinstance(bins, bool) or bins < 1:
+        raise SweepError(f"{where}.bins: {bins!r}; accepted: an integer >= 1")
     if entry.get("kind", "line") not in ("line", "rate"):
         raise SweepError(f"{where}.kind: {entry.get('kind')!r}; accepted: line | rate")
     for key in ("x", "y"):
@@ -257,7 +269,8 @@ def _figure(i: int, entry) -> Figure:
         x=entry["x"],
         y=entry["y"],
         group=entry.get("group"),
-        bins=int(entry.get("bins", 6)),
+        bins=bins,
+        range=span,
         title=entry.get("title"),
     )
 
@@ -508,9 +521,10 @@ def run_sweep(
                     retry = False
                 else:  # the worker died or the cluster lost the task: not the run's fault
                     exc = future.exception()
+                    text = " ".join(str(exc).split())
                     metrics = {
                         "success": False,
-                        "failure_reason": f"cluster: {type(exc).__name__}: {exc}"[:300],
+                        "failure_reason": f"cluster: {type(exc).__name__}: {text}"[:300],
                     }
                     retry = True
                 record = {
@@ -644,6 +658,16 @@ def read_table(path: Path) -> list[dict]:
         return [{k: parse(v) for k, v in row.items()} for row in csv.DictReader(f)]
 
 
+def _order(value):
+    """Sorts numbers numerically and before anything else."""
+    return (0, value, "") if isinstance(value, (int, float)) else (1, 0, str(value))
+
+
+def _number(value) -> float | None:
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+    return float(value) if ok and math.isfinite(value) else None
+
+
 def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
     """line: mean y per x value (one line per group; runs that did not stand
     up drawn as crosses on the x axis); rate: mean of y (e.g. success) per x bin,
@@ -658,28 +682,44 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
         return None
     fig_obj, ax = plt.subplots(figsize=(6.4, 4.2))
     if fig.kind == "line":
-        groups = sorted({row.get(fig.group) for row in rows}, key=str) if fig.group else [None]
-        for g in groups:
+        groups = sorted({row.get(fig.group) for row in rows}, key=_order) if fig.group else [None]
+        markers = "osD^v<>p"
+        for k, g in enumerate(groups):
             sel = [r for r in rows if fig.group is None or r.get(fig.group) == g]
-            xs = sorted({r[fig.x] for r in sel})
+            xs = sorted({r[fig.x] for r in sel}, key=_order)
             mean = []
             for x in xs:
-                ys = [r.get(fig.y) for r in sel if r[fig.x] == x and r.get(fig.y) is not None]
-                ys = [y for y in ys if isinstance(y, (int, float))]
+                ys = [_number(r.get(fig.y)) for r in sel if r[fig.x] == x and r.get("success")]
+                ys = [y for y in ys if y is not None]
                 mean.append(float(np.mean(ys)) if ys else np.nan)
             label = f"{fig.group} = {g}" if fig.group else None
-            (line,) = ax.plot(xs, mean, "o-", label=label)
-            lost = [r[fig.x] for r in sel if not r.get("success")]
-            if lost:
-                ax.plot(lost, [0.0] * len(lost), "x", color=line.get_color(), ms=9)
+            (line,) = ax.plot(xs, mean, marker=markers[k % len(markers)], label=label)
+            # Failed runs: a cross at their value, or on the x axis without one.
+            failed = [r for r in sel if not r.get("success")]
+            if failed:
+                ax.plot(
+                    [r[fig.x] for r in failed],
+                    [_number(r.get(fig.y)) or 0.0 for r in failed],
+                    "x",
+                    color=line.get_color(),
+                    ms=10,
+                    mew=2,
+                )
         if fig.group:
             ax.legend(fontsize=8)
         ax.set_ylabel(fig.y)
-        ax.text(0.01, 0.01, "x: did not stand up", transform=ax.transAxes, fontsize=7)
+        ax.text(
+            0.01,
+            0.01,
+            "lines: mean over runs that stood up; x: a run that failed (reason in results.csv)",
+            transform=ax.transAxes,
+            fontsize=7,
+        )
     else:
         xs = np.array([r[fig.x] for r in rows], dtype=float)
         ys = np.array([float(bool(r.get(fig.y))) for r in rows])
-        edges = np.linspace(xs.min(), xs.max(), fig.bins + 1) if len(xs) else np.array([0, 1])
+        low, high = fig.range or (xs.min(), xs.max())
+        edges = np.linspace(low, high, fig.bins + 1)
         which = np.clip(np.digitize(xs, edges[1:-1]), 0, fig.bins - 1)
         centres, rates, counts = [], [], []
         for b in range(fig.bins):
@@ -689,7 +729,7 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
                 rates.append(ys[sel].mean())
                 counts.append(int(sel.sum()))
         width = (edges[1] - edges[0]) * 0.9 if len(edges) > 1 else 1.0
-        ax.bar(centres, rates, width=width, color="tab:blue", alpha=0.7)
+        ax.bar(centres, rates, width=width, color="tab:blue", alpha=0.7, edgecolor="tab:blue")
         for c, r, n in zip(centres, rates, counts):
             ax.text(c, r + 0.02, f"n={n}", ha="center", fontsize=8)
         ax.set_ylim(0, 1.15)
@@ -758,11 +798,23 @@ def main(argv: list[str] | None = None) -> int:
     print(f"wrote table: {result.table}")
     for path in result.figures:
         print(f"wrote figure: {path}")
-    rate = 60.0 * result.computed / result.wall_s if result.computed and result.wall_s else 0.0
+    resumed = len(records) - result.computed
+    if result.computed:
+        rate = 60.0 * result.computed / result.wall_s
+        work = f"{result.computed} simulated in {result.wall_s:.0f} s ({rate:.1f} runs/min)"
+        work += f", {resumed} resumed" if resumed else ""
+    else:
+        work = f"all {resumed} resumed from {out / 'runs'}"
+    lost = [r for r in records if r.get("retry")]
+    if lost:
+        print(
+            f"warning: {len(lost)} runs lost to the cluster, not simulated (first: "
+            f"{lost[0]['metrics']['failure_reason'][:160]}); the same command retries them",
+            file=sys.stderr,
+        )
     print(
-        f"sweep {spec.name}: {len(records)} runs, {stood} stood up, {len(records) - stood} did "
-        f"not; {result.computed} simulated now in {result.wall_s:.0f} s ({rate:.1f} runs/min), "
-        f"{len(records) - result.computed} resumed"
+        f"sweep {spec.name}: {len(records)} runs, {stood} stood up, "
+        f"{len(records) - stood} did not; {work}"
     )
     return 0
 

@@ -152,6 +152,14 @@ def test_seeded_random_draws_are_reproducible_and_per_run(tmp_path):
             "{uniform: [low, high]}",
         ),
         ("base: scenarios/assisted.yaml\nsamples: 0\n", "samples: 0; accepted"),
+        (
+            "base: scenarios/assisted.yaml\nfigures: [{kind: pie, x: a, y: b}]\n",
+            "figures[0].kind: 'pie'; accepted: line | rate",
+        ),
+        (
+            "base: scenarios/assisted.yaml\nfigures: [{kind: rate, x: a, y: b, range: [2, 1]}]\n",
+            "figures[0].range: [2, 1]; accepted: [low, high]",
+        ),
     ],
 )
 def test_bad_sweep_files_fail_with_one_line_naming_the_key(tmp_path, text, message):
@@ -299,3 +307,21 @@ def test_explicit_scheduler_at_an_address_gives_the_same_table(tmp_path):
     a = read_table(tmp_path / "a" / "results.csv")
     b = read_table(tmp_path / "b" / "results.csv")
     assert len(a) == 4 and _physics(a) == _physics(b)
+
+
+def test_sweep_bench_runs_the_same_sweep_on_each_worker_count(tmp_path, capsys):
+    """The throughput benchmark's mechanics (not its numbers: no timing test)."""
+    import json
+
+    from drake_standup import sweep_bench
+
+    spec = _write(tmp_path, SMALL)
+    out = tmp_path / "bench"
+    assert sweep_bench.main(["--spec", str(spec), "--workers", "1", "2", "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert set(summary["workers"]) == {"1", "2"}
+    for n in ("1", "2"):
+        assert summary["workers"][n]["runs"] == 4
+        assert (out / f"workers_{n}" / "results.csv").is_file()
+    assert summary["workers"]["1"]["throughput_vs_first"] == 1.0
+    assert summary["same_results_for_every_worker_count"] is True
