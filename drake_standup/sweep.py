@@ -110,6 +110,14 @@ TOP_KEYS = (
 )
 PERTURBATION_KEYS = ("push", "mass_scale", "friction_scale", "hand_wrench_noise_N")
 PUSH_KEYS = ("body", "start_s", "duration_s", "magnitude_N", "azimuth_deg", "elevation_deg")
+# What a push key left out of a sweep file means (config.Push's defaults).
+PUSH_DEFAULTS = {
+    "start_s": 5.0,
+    "duration_s": 0.2,
+    "magnitude_N": 0.0,
+    "azimuth_deg": 0.0,
+    "elevation_deg": 0.0,
+}
 
 
 def load_sweep(path: str | Path) -> SweepSpec:
@@ -151,6 +159,8 @@ def load_sweep(path: str | Path) -> SweepSpec:
         _known("perturbations.push", perturbations["push"], PUSH_KEYS)
         for key in PUSH_KEYS[1:]:
             _check_draw(f"perturbations.push.{key}", perturbations["push"].get(key, 0.0))
+        if not isinstance(perturbations["push"].get("body", "chest"), str):
+            raise SweepError("perturbations.push.body: accepted: the name of a robot body")
     for key in PERTURBATION_KEYS[1:]:
         if key in perturbations:
             _check_draw(f"perturbations.{key}", perturbations[key])
@@ -334,9 +344,8 @@ def expand(spec: SweepSpec) -> list[RunSpec]:
             if "push" in pert:
                 push = pert["push"]
                 start, duration, magnitude, azimuth, elevation = (
-                    _draw(rng, push.get(k, 0.0)) for k in PUSH_KEYS[1:]
+                    _draw(rng, push.get(k, PUSH_DEFAULTS[k])) for k in PUSH_KEYS[1:]
                 )
-                duration = duration or 0.2
                 az, el = math.radians(azimuth), math.radians(elevation)
                 force = [
                     magnitude * math.cos(el) * math.cos(az),
