@@ -802,6 +802,14 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as err:  # e.g. no scheduler at --address
         print(f"error: --address {args.address}: {err}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        saved = len(list((out / "runs").glob("*.json")))
+        print(
+            f"\ninterrupted: {saved} run records in {out / 'runs'}; "
+            "the same command resumes from there",
+            file=sys.stderr,
+        )
+        return 130
     records = [result.records[r.run_id] for r in result.runs]
     stood = sum(bool(r["metrics"].get("success")) for r in records)
     print(f"wrote table: {result.table}")
