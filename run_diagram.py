@@ -11,17 +11,11 @@ import math
 import sys
 from pathlib import Path
 
-
-class _OneLineErrorParser(argparse.ArgumentParser):
-    """argparse, but a bad argument is one 'error:' line and exit code 2."""
-
-    def error(self, message: str) -> None:
-        print(f"error: {message}; see --help", file=sys.stderr)
-        sys.exit(2)
+from drake_standup.cli import OneLineErrorParser
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = _OneLineErrorParser(
+    parser = OneLineErrorParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     parser.add_argument(

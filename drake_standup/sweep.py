@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from drake_standup.cli import OneLineErrorParser
 from drake_standup.config import (
     REPO_ROOT,
     ScenarioError,
@@ -646,6 +647,16 @@ def _cell(value):
     return value
 
 
+# Columns that measure the machine, not the simulation.
+TIMING_COLUMNS = ("wall_time_s", "run_wall_s", "realtime_factor", "build_time_s")
+
+
+def simulation_rows(path: Path) -> list[dict]:
+    """results.csv without its timing columns: what two sweeps of the same
+    file must agree on, whatever ran them."""
+    return [{k: v for k, v in row.items() if k not in TIMING_COLUMNS} for row in read_table(path)]
+
+
 def read_table(path: Path) -> list[dict]:
     """results.csv back as dicts of numbers, booleans and strings."""
 
@@ -756,14 +767,8 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
 # --- Command line -------------------------------------------------------------
 
 
-class _OneLineErrorParser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:
-        print(f"error: {message}; see --help", file=sys.stderr)
-        sys.exit(2)
-
-
 def main(argv: list[str] | None = None) -> int:
-    parser = _OneLineErrorParser(
+    parser = OneLineErrorParser(
         prog="python -m drake_standup.sweep",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,

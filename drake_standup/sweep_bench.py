@@ -22,10 +22,9 @@ import sys
 import time
 from pathlib import Path
 
+from drake_standup.cli import OneLineErrorParser
 from drake_standup.config import REPO_ROOT
-from drake_standup.sweep import load_sweep, read_table, run_sweep
-
-TIMING_COLUMNS = ("wall_time_s", "run_wall_s", "realtime_factor", "build_time_s")
+from drake_standup.sweep import load_sweep, run_sweep, simulation_rows
 
 
 def _git() -> dict:
@@ -41,12 +40,8 @@ def _git() -> dict:
     return {"commit": run("rev-parse", "--short", "HEAD"), "dirty": bool(run("status", "-s"))}
 
 
-def _physics(path: Path) -> list[dict]:
-    return [{k: v for k, v in row.items() if k not in TIMING_COLUMNS} for row in read_table(path)]
-
-
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
+    parser = OneLineErrorParser(
         prog="python -m drake_standup.sweep_bench",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -77,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
             "stood_up": sum(bool(r["metrics"].get("success")) for r in records),
             "out": str(out),
         }
-        tables[n] = _physics(result.table)
+        tables[n] = simulation_rows(result.table)
     first = args.workers[0]
     for n in args.workers:
         results[n]["throughput_vs_first"] = round(
