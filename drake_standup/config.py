@@ -378,6 +378,37 @@ def _format_key_path(steps: list[str | int]) -> str:
     return out.lstrip(".")
 
 
+def _child(path: str, obj, schema, step: str | int, done: list, new_key_ok: bool = False):
+    """One concrete step of a key path: (the value there, its declared type).
+
+    new_key_ok: a key not yet in a mapping (e.g. a joint of joints_rad) is
+    allowed; its value is then None.
+    """
+    where = _format_key_path(done) or "scenario"
+    if isinstance(step, str):
+        fields = _fields(schema)
+        if fields is not None:
+            if step not in fields:
+                raise ScenarioError(
+                    f"key path '{path}': {where} has no key '{step}'; accepted: {', '.join(fields)}"
+                )
+            return getattr(obj, step), fields[step]
+        if isinstance(obj, dict):
+            if step not in obj and not new_key_ok:
+                raise ScenarioError(
+                    f"key path '{path}': {where} has no key '{step}'; accepted: {', '.join(obj)}"
+                )
+            return obj.get(step), typing.get_args(schema)[1]
+        raise ScenarioError(f"key path '{path}': {where} is a value, not a mapping")
+    if not isinstance(obj, list):
+        raise ScenarioError(f"key path '{path}': {where} is not a list")
+    if step >= len(obj):
+        raise ScenarioError(
+            f"key path '{path}': index {step} out of range; {where} has {len(obj)} entries"
+        )
+    return obj[step], typing.get_args(schema)[0]
+
+
 def expand_key_path(scenario: Scenario, path: str) -> list[str]:
     """The concrete key paths a path names in scenario ([*]: every element)."""
     steps = _parse_key_path(path)
@@ -388,35 +419,15 @@ def expand_key_path(scenario: Scenario, path: str) -> list[str]:
             found.append(done)
             return
         step, rest = rest[0], rest[1:]
-        where = _format_key_path(done) or "scenario"
-        if isinstance(step, str) and step != "*":
-            fields = _fields(schema)
-            if fields is not None:
-                if step not in fields:
-                    raise ScenarioError(
-                        f"key path '{path}': {where} has no key '{step}'; "
-                        f"accepted: {', '.join(fields)}"
-                    )
-                walk(getattr(obj, step), fields[step], done + [step], rest)
-            elif isinstance(obj, dict):
-                if step not in obj:
-                    raise ScenarioError(
-                        f"key path '{path}': {where} has no key '{step}'; "
-                        f"accepted: {', '.join(obj)}"
-                    )
-                walk(obj[step], typing.get_args(schema)[1], done + [step], rest)
-            else:
-                raise ScenarioError(f"key path '{path}': {where} is a value, not a mapping")
-            return
-        if not isinstance(obj, list):
-            raise ScenarioError(f"key path '{path}': {where} is not a list")
-        indices = range(len(obj)) if step == "*" else [step]
-        for i in indices:
-            if i >= len(obj):
-                raise ScenarioError(
-                    f"key path '{path}': index {i} out of range; {where} has {len(obj)} entries"
-                )
-            walk(obj[i], typing.get_args(schema)[0], done + [i], rest)
+        if step == "*":
+            if not isinstance(obj, list):
+                where = _format_key_path(done) or "scenario"
+                raise ScenarioError(f"key path '{path}': {where} is not a list")
+            concrete = list(range(len(obj)))
+        else:
+            concrete = [step]
+        for c in concrete:
+            walk(*_child(path, obj, schema, c, done), done + [c], rest)
 
     walk(scenario, Scenario, [], steps)
     return [_format_key_path(s) for s in found]
@@ -432,37 +443,16 @@ def set_key_path(scenario: Scenario, path: str, value) -> None:
     if "*" in steps:
         raise ScenarioError(f"key path '{path}': [*] names several keys; set them one by one")
     parent, schema = scenario, Scenario
-    for depth, step in enumerate(steps):
-        where = _format_key_path(steps[: depth + 1])
-        if isinstance(step, str):
-            fields = _fields(type(parent)) if not isinstance(parent, dict) else None
-            if fields is not None:
-                if step not in fields:
-                    raise ScenarioError(
-                        f"key path '{path}': no key '{step}'; accepted: {', '.join(fields)}"
-                    )
-                schema = fields[step]
-                current = getattr(parent, step)
-            elif isinstance(parent, dict):
-                schema = typing.get_args(schema)[1]
-                current = parent.get(step)
-            else:
-                raise ScenarioError(f"key path '{path}': not a mapping before '{step}'")
-        else:
-            if not isinstance(parent, list) or step >= len(parent):
-                n = len(parent) if isinstance(parent, list) else 0
-                raise ScenarioError(f"key path '{path}': index {step} out of range ({n} entries)")
-            schema = typing.get_args(schema)[0]
-            current = parent[step]
-        if depth == len(steps) - 1:
-            _check_schema(where, value, schema)
-            new = _typed(schema, value)
-            if isinstance(step, int) or isinstance(parent, dict):
-                parent[step] = new
-            else:
-                setattr(parent, step, new)
-            return
-        parent = current
+    for depth, step in enumerate(steps[:-1]):
+        parent, schema = _child(path, parent, schema, step, steps[:depth])
+    step = steps[-1]
+    _, schema = _child(path, parent, schema, step, steps[:-1], new_key_ok=True)
+    _check_schema(_format_key_path(steps), value, schema)
+    new = _typed(schema, value)
+    if isinstance(step, int) or isinstance(parent, dict):
+        parent[step] = new
+    else:
+        setattr(parent, step, new)
 
 
 def _typed(schema, value):
