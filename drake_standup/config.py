@@ -563,6 +563,8 @@ def validate(scenario: Scenario) -> None:
     _positive("robot.effort_limit_Nm", scenario.robot.effort_limit_Nm)
     _positive("log_period_s", scenario.log_period_s, allow_zero=False)
     _positive("controller_period_s", scenario.controller_period_s)
+    _positive("simulator.max_step_size", scenario.simulator.max_step_size)
+    _check_rates(scenario.plant.time_step, scenario.controller_period_s)
     _positive("visualization.publish_period_s", scenario.visualization.publish_period_s)
     _positive("robot.visual_max_faces", scenario.robot.visual_max_faces)
     if not _resolve(scenario.chair.file).is_file():
@@ -576,6 +578,20 @@ def validate(scenario: Scenario) -> None:
     _validate_advancement(scenario.advancement)
     _validate_standup(scenario.standup)
     _validate_perturbation(scenario.perturbation)
+
+
+def _check_rates(time_step: float, period_s: float) -> None:
+    """The controller's period is a whole multiple of a discrete plant's step:
+    the plant reads its actuation input only at its own steps, so a faster
+    controller is wasted work and a period off the plant's grid jitters."""
+    if time_step == 0.0:
+        return
+    ratio = period_s / time_step
+    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+        raise ScenarioError(
+            f"controller_period_s: {period_s}; accepted: a whole multiple of plant.time_step "
+            f"({time_step}), e.g. {time_step} or {2 * time_step}"
+        )
 
 
 def _resolve(path: str) -> Path:

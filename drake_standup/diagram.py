@@ -30,6 +30,7 @@ class StandupDiagram:
     diagram: Diagram
     scene: Scene
     pad_groups: dict[str, str]  # pad geometry name -> group, in reporter order
+    joints: ActuatedJoints
     state_machine: StandupStateMachine
     advancement: TrajectoryAdvancement
     controller: WholeBodyController | None
@@ -176,7 +177,15 @@ def build_diagram(
     diagram = builder.Build()
     diagram.set_name("standup")
     return StandupDiagram(
-        diagram, scene, pad_groups, state_machine, advancement, controller_system, logs, visualizer
+        diagram,
+        scene,
+        pad_groups,
+        actuated_joints(plant, instance),
+        state_machine,
+        advancement,
+        controller_system,
+        logs,
+        visualizer,
     )
 
 
@@ -232,17 +241,35 @@ def add_seat_hold(builder: DiagramBuilder, scene: Scene, scenario: Scenario) -> 
     builder.Connect(feedforward.get_output_port(), plant.get_actuation_input_port(instance))
 
 
+@dataclass
+class ActuatedJoints:
+    """The instance's actuated joints in actuation order (the order of the
+    actuation input and net_actuation output), and where each joint's position
+    and velocity sit in the instance's state [q; v]."""
+
+    names: list[str]
+    q_index: np.ndarray  # (n_u,) into the instance's q
+    v_index: np.ndarray  # (n_u,) into the instance's v
+
+
+def actuated_joints(plant, instance) -> ActuatedJoints:
+    joints = [plant.get_joint(j) for j in plant.GetJointIndices(instance)]
+    first_q = min(j.position_start() for j in joints if j.num_positions() > 0)
+    first_v = min(j.velocity_start() for j in joints if j.num_velocities() > 0)
+    actuators = sorted(
+        (plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(instance)),
+        key=lambda a: a.input_start(),
+    )
+    return ActuatedJoints(
+        names=[a.joint().name() for a in actuators],
+        q_index=np.array([a.joint().position_start() - first_q for a in actuators]),
+        v_index=np.array([a.joint().velocity_start() - first_v for a in actuators]),
+    )
+
+
 def _actuated_position_selector(plant, instance) -> np.ndarray:
     """Rows pick each actuated joint's position out of the instance's q."""
-    n_q = plant.num_positions(instance)
-    n_u = plant.num_actuated_dofs(instance)
-    first_q = min(
-        plant.get_joint(j).position_start()
-        for j in plant.GetJointIndices(instance)
-        if plant.get_joint(j).num_positions() > 0
-    )
-    S = np.zeros((n_u, n_q))
-    for index in plant.GetJointActuatorIndices(instance):
-        actuator = plant.get_joint_actuator(index)
-        S[actuator.input_start(), actuator.joint().position_start() - first_q] = 1.0
+    joints = actuated_joints(plant, instance)
+    S = np.zeros((len(joints.names), plant.num_positions(instance)))
+    S[np.arange(len(joints.names)), joints.q_index] = 1.0
     return S

@@ -34,6 +34,33 @@ def write_metrics(path: Path, metrics: dict) -> None:
     path.write_text(json.dumps(json_safe(metrics), indent=2) + "\n")
 
 
+# --- signals.npz ---------------------------------------------------------------
+
+# Version of signals.npz's layout; bump it (and keep load_signals reading the
+# old ones) when an array changes meaning or shape.
+SIGNALS_FORMAT = 1
+
+
+def write_signals(path: Path, signals: dict[str, np.ndarray]) -> None:
+    """Saves the run's logged time series (see README, "signals.npz").
+
+    Strings are stored as numpy unicode arrays, so numpy.load needs no pickle.
+    """
+    np.savez_compressed(path, format=np.array(SIGNALS_FORMAT), **signals)
+
+
+def load_signals(path: Path) -> dict[str, np.ndarray]:
+    """signals.npz as a dict of arrays (the 'format' entry left out)."""
+    with np.load(path) as data:
+        version = int(data["format"]) if "format" in data.files else 1
+        if version > SIGNALS_FORMAT:
+            raise ValueError(
+                f"{path}: signals format {version} is newer than this drake_standup "
+                f"reads ({SIGNALS_FORMAT})"
+            )
+        return {k: data[k] for k in data.files if k != "format"}
+
+
 def write_recording(meshcat: Meshcat, path: Path) -> int:
     """Saves Meshcat's self-contained HTML (scene + recording); returns bytes."""
     html = meshcat.StaticHtml()
@@ -60,47 +87,35 @@ def export_diagram(diagram: Diagram, directory: Path, stem: str = "standup") -> 
     return written
 
 
-def group_normal_forces(pad_forces_W: np.ndarray, pad_groups: dict[str, str]) -> dict:
-    """Group name -> summed normal (z) force of its pads over time, (N,) each.
-
-    pad_forces_W is (n_pads, 3, N) with rows in the order of pad_groups.
-    """
-    groups = list(pad_groups.values())
+def group_normal_forces(signals: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Group name -> summed normal force of its pads over time, (N,) each, in
+    the order the groups first appear in pad_groups."""
+    groups = [str(g) for g in signals["pad_groups"]]
+    normal = signals["pad_normal_force_N"]
     return {
-        group: pad_forces_W[[i for i, g in enumerate(groups) if g == group], 2].sum(axis=0)
+        group: normal[:, [i for i, g in enumerate(groups) if g == group]].sum(axis=1)
         for group in dict.fromkeys(groups)
     }
 
 
-def seated_metrics(
-    times_s: np.ndarray,
-    com_W: np.ndarray,
-    pad_forces_W: np.ndarray,
-    pad_groups: dict[str, str],
-    weight_N: float,
-    settle_s: float = 0.5,
-) -> dict:
-    """CoM drift after settling and the contact forces at the end of the run.
-
-    pad_forces_W is (n_pads, 3, N): the world force on each robot pad, rows in
-    the order of pad_groups (pad name -> group name, e.g. "soles").
-    """
-    pad_names = list(pad_groups)
+def seated_metrics(signals: dict[str, np.ndarray], weight_N: float, settle_s: float = 0.5) -> dict:
+    """CoM drift after settling and the contact forces at the end of the run."""
+    t = signals["time_s"]
+    com = signals["com_W"]
     metrics: dict = {"weight_N": weight_N}
-    if len(times_s) == 0:
+    if len(t) == 0:
         return metrics
-    after = times_s >= settle_s
+    after = t >= settle_s
     if after.any():
-        ref = com_W[:, np.argmax(after)]
-        drift = np.linalg.norm(com_W[:, after] - ref[:, None], axis=0)
+        drift = np.linalg.norm(com[after] - com[np.argmax(after)], axis=1)
         metrics["com_drift_after_settle_m"] = float(drift.max())
-    metrics["com_final_m"] = com_W[:, -1]
-    if pad_forces_W.shape[-1] > 0:
-        final = pad_forces_W[:, :, -1]
-        metrics["contact_force_N"] = {n: final[i] for i, n in enumerate(pad_names)}
-        by_group = group_normal_forces(pad_forces_W, pad_groups)
-        metrics["contact_normal_force_N"] = {g: float(fz[-1]) for g, fz in by_group.items()}
-        metrics["contact_force_total_N"] = final.sum(axis=0)
+    metrics["com_final_m"] = com[-1]
+    final = signals["pad_forces_W"][-1]  # (pads, 3)
+    metrics["contact_force_N"] = {str(n): final[i] for i, n in enumerate(signals["pad_names"])}
+    metrics["contact_normal_force_N"] = {
+        g: float(fz[-1]) for g, fz in group_normal_forces(signals).items()
+    }
+    metrics["contact_force_total_N"] = final.sum(axis=0)
     return metrics
 
 
@@ -140,42 +155,52 @@ def _mark_states(ax, entry_times_s, label: bool = False) -> None:
             )
 
 
-def figure_advancement(signals: dict, baseline: dict | None, entry_times_s, path: Path) -> None:
+def figure_advancement(
+    signals: dict[str, np.ndarray],
+    baseline: dict[str, np.ndarray] | None,
+    entry_times_s,
+    path: Path,
+) -> None:
     """The paper's Fig. 3: hand wrench, psi_dot, psi, and the CoM reference
     (with the same run's reference without advancement, faded)."""
     plt = _plt()
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
     (ax_f, ax_dpsi), (ax_psi, ax_ref) = axes
+    t = signals["time_s"]
 
-    t, w = signals["hand_wrenches_W"]
-    for hand, row, ls in (("left", 0, "-"), ("right", 6, "--")):
+    w = signals["hand_wrenches_W"]
+    for hand, col, ls in (("left", 0, "-"), ("right", 6, "--")):
         for axis, color in ((0, "tab:red"), (2, "tab:blue")):
             name = "xyz"[axis]
-            ax_f.plot(t, w[row + 3 + axis], ls, color=color, label=f"{hand} f_{name}")
+            ax_f.plot(t, w[:, col + 3 + axis], ls, color=color, label=f"{hand} f_{name}")
     ax_f.set_ylabel("hand force [N]")
     ax_f.set_title("(a) interaction wrench at the hands")
     ax_f.legend(fontsize=8, ncol=2)
 
-    t, psi_dot = signals["psi_dot"]
-    ax_dpsi.plot(t, psi_dot[0], color="tab:green")
+    ax_dpsi.plot(t, signals["psi_dot"], color="tab:green")
     ax_dpsi.axhline(1.0, color="gray", lw=0.8)
     ax_dpsi.set_ylabel("psi_dot [-]")
     ax_dpsi.set_title("(b) rate of the free parameter")
 
-    t, psi = signals["psi"]
-    ax_psi.plot(t, psi[0], color="tab:green", label="psi")
+    ax_psi.plot(t, signals["psi"], color="tab:green", label="psi")
     ax_psi.plot(t, t, color="gray", lw=0.8, ls="--", label="psi = t")
     ax_psi.set_ylabel("psi [-]")
     ax_psi.set_title("(c) free parameter")
     ax_psi.legend(fontsize=8)
 
-    t, ref = signals["com_reference"]
+    ref = signals["com_reference_W"]
     for axis, color in ((0, "tab:red"), (2, "tab:blue")):
         name = "xyz"[axis]
-        ax_ref.plot(t, ref[axis], color=color, label=f"x_d,{name} with advancement")
+        ax_ref.plot(t, ref[:, axis], color=color, label=f"x_d,{name} with advancement")
         if baseline is not None:
-            tb, refb = baseline["com_reference"]
-            ax_ref.plot(tb, refb[axis], color=color, alpha=0.3, lw=3, label=f"x_d,{name} psi = t")
+            ax_ref.plot(
+                baseline["time_s"],
+                baseline["com_reference_W"][:, axis],
+                color=color,
+                alpha=0.3,
+                lw=3,
+                label=f"x_d,{name} psi = t",
+            )
     ax_ref.set_ylabel("CoM reference [m]")
     ax_ref.set_title("(d) CoM reference")
     ax_ref.legend(fontsize=8)
@@ -189,21 +214,25 @@ def figure_advancement(signals: dict, baseline: dict | None, entry_times_s, path
     plt.close(fig)
 
 
-def figure_tracking(signals: dict, pad_groups: dict[str, str], entry_times_s, path: Path) -> None:
+def figure_tracking(signals: dict[str, np.ndarray], entry_times_s, path: Path) -> None:
     """CoM against its reference, and the contact normal forces, with the
     state switches marked."""
     plt = _plt()
     fig, (ax_x, ax_z, ax_f) = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
-    t, com = signals["com_W"]
-    tr, ref = signals["com_reference"]
+    t = signals["time_s"]
     for ax, axis in ((ax_x, 0), (ax_z, 2)):
         name = "xyz"[axis]
-        ax.plot(tr, ref[axis], color="black", ls="--", label=f"reference x_d,{name}")
-        ax.plot(t, com[axis], color="tab:blue", label=f"CoM {name}")
+        ax.plot(
+            t,
+            signals["com_reference_W"][:, axis],
+            color="black",
+            ls="--",
+            label=f"reference x_d,{name}",
+        )
+        ax.plot(t, signals["com_W"][:, axis], color="tab:blue", label=f"CoM {name}")
         ax.set_ylabel(f"CoM {name} [m]")
         ax.legend(fontsize=8)
-    t, pads = signals["pad_forces_W"]
-    for group, fz in group_normal_forces(pads.reshape(len(pad_groups), 3, -1), pad_groups).items():
+    for group, fz in group_normal_forces(signals).items():
         ax_f.plot(t, fz, label=group)
     ax_f.set_ylabel("normal force [N]")
     ax_f.set_xlabel("time [s]")
@@ -218,8 +247,7 @@ def figure_tracking(signals: dict, pad_groups: dict[str, str], entry_times_s, pa
 
 
 def standup_metrics(
-    signals: dict,
-    pad_groups: dict[str, str],
+    signals: dict[str, np.ndarray],
     entry_times_s,
     *,
     com_tolerance_m: float = 0.02,
@@ -232,18 +260,12 @@ def standup_metrics(
     the soles loaded (every other pad below unloaded_N). standup_time_s runs
     from entering state 2 to the first standing sample (None if never).
     """
-    t, com = signals["com_W"]
-    _, ref = signals["com_reference"]
-    _, psi = signals["psi"]
-    _, state = signals["standup_state"]
-    _, segment = signals["segment"]
-    _, pads = signals["pad_forces_W"]
-    pads = pads.reshape(len(pad_groups), 3, -1)
-    error = np.linalg.norm(com - ref[:3], axis=0)
-    others = [i for i, g in enumerate(pad_groups.values()) if g != "soles"]
-    seat_free = np.all(pads[others, 2] < unloaded_N, axis=0)
-    path_done = psi[0] - segment[0] >= segment[1]
-    standing = (state[0] == 4) & path_done & (error <= com_tolerance_m) & seat_free
+    t = signals["time_s"]
+    error = np.linalg.norm(signals["com_W"] - signals["com_reference_W"], axis=1)
+    others = [i for i, g in enumerate(signals["pad_groups"]) if str(g) != "soles"]
+    seat_free = np.all(signals["pad_normal_force_N"][:, others] < unloaded_N, axis=1)
+    path_done = signals["psi"] - signals["segment_psi_entry"] >= signals["segment_psi_length"]
+    standing = (signals["state"] == 4) & path_done & (error <= com_tolerance_m) & seat_free
     metrics: dict = {
         "com_tracking_rms_m": float(np.sqrt(np.mean(error**2))) if len(t) else None,
         "standing_at_end": bool(standing[-1]) if len(t) else False,

@@ -6,11 +6,17 @@ The one function that run_diagram.py, the benchmark and the sweeps call.
 from __future__ import annotations
 
 import copy
+import json
+import shutil
+import subprocess
+import sys
+import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from pydrake.common.yaml import yaml_dump_typed
 from pydrake.geometry import Meshcat, MeshcatParams
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import EventStatus
@@ -29,29 +35,30 @@ GRAVITY_MPS2 = 9.81
 class RunResult:
     metrics: dict
     files: dict[str, Path] = field(default_factory=dict)
-    # Logged signal name -> (sample times (N,), data (size, N)).
-    signals: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
-    pad_groups: dict[str, str] = field(default_factory=dict)  # pad -> group, log order
+    # The run's time series on one time grid, as signals.npz holds them
+    # (make_signals; README, "signals.npz").
+    signals: dict[str, np.ndarray] = field(default_factory=dict)
     # WholeBodyController.timing_s(): per-tick compute times, (ticks, 5) in the
     # columns of WholeBodyController.TIMING; None without that controller.
     controller_timing_s: np.ndarray | None = None
 
     @property
     def times_s(self) -> np.ndarray:
-        return self.signals["com_W"][0]
+        return self.signals["time_s"]
 
     @property
     def com_W(self) -> np.ndarray:
-        return self.signals["com_W"][1]
+        """(N, 3)."""
+        return self.signals["com_W"]
 
     @property
     def pad_forces_W(self) -> np.ndarray:
-        """(n_pads, 3, N) world force on each pad."""
-        return self.signals["pad_forces_W"][1].reshape(len(self.pad_groups), 3, -1)
+        """(N, n_pads, 3) world force on each pad."""
+        return self.signals["pad_forces_W"]
 
     @property
     def pad_names(self) -> list[str]:
-        return list(self.pad_groups)
+        return [str(n) for n in self.signals["pad_names"]]
 
 
 def make_meshcat() -> Meshcat:
@@ -77,30 +84,106 @@ def simulate(
     human, or advancement already off) the run is its own baseline.
     controller: 'whole_body', or 'seat_hold' (the plant-only benchmark).
     """
-    base = None
+    pending = None
     if baseline and scenario.advancement.enabled and _human_acts(scenario):
         base_scenario = copy.deepcopy(scenario)
         base_scenario.advancement.enabled = False
-        base = _simulate_one(
-            base_scenario,
-            None,
-            record=False,
+        pending = _Baseline(base_scenario, controller, chunk_s)
+    try:
+        return _simulate_one(
+            scenario,
+            out_dir,
+            record=record,
             progress=progress,
             chunk_s=chunk_s,
-            label="baseline (psi = t)",
+            label="simulating",
+            baseline=pending,
             controller=controller,
         )
+    except BaseException:
+        if pending is not None:
+            pending.cancel()
+        raise
+
+
+class _Baseline:
+    """The psi = t run, simulated beside the main run in a Python process of
+    its own (on two cores it then costs no wall time). The scenario goes to
+    it as YAML, signals.npz and metrics.json come back through a temporary
+    folder. Where that process cannot run (e.g. inside a daemonic Dask
+    worker, or it fails), the run is simulated here instead."""
+
+    def __init__(self, scenario: Scenario, controller: str, chunk_s: float):
+        self._scenario = scenario
+        self._controller = controller
+        self._chunk_s = chunk_s
+        self._dir = Path(tempfile.mkdtemp(prefix="drake_standup_baseline_"))
+        (self._dir / "scenario.yaml").write_text(yaml_dump_typed(scenario))
+        command = [sys.executable, "-m", "drake_standup.simulate", "--baseline-dir"]
+        command += [str(self._dir), "--controller", controller, "--chunk", repr(chunk_s)]
+        self._stderr = open(self._dir / "stderr.txt", "w")  # noqa: SIM115 - closed in result()
+        self._process = subprocess.Popen(
+            command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self._stderr
+        )
+
+    def result(self) -> RunResult:
+        try:
+            returncode = self._process.wait()
+            self._stderr.close()
+            if returncode == 0:
+                return RunResult(
+                    json.loads((self._dir / "metrics.json").read_text()),
+                    signals=outputs.load_signals(self._dir / "signals.npz"),
+                )
+            lines = (self._dir / "stderr.txt").read_text().strip().splitlines()
+            print(
+                f"notice: the psi = t run's process failed ({lines[-1] if lines else returncode});"
+                " simulating it here",
+                file=sys.stderr,
+            )
+            return _simulate_one(
+                self._scenario,
+                None,
+                record=False,
+                progress=False,
+                chunk_s=self._chunk_s,
+                label="baseline (psi = t)",
+                controller=self._controller,
+            )
+        finally:
+            shutil.rmtree(self._dir, ignore_errors=True)
+
+    def cancel(self) -> None:
+        self._process.kill()
+        self._process.wait()
+        self._stderr.close()
+        shutil.rmtree(self._dir, ignore_errors=True)
+
+
+def _baseline_main(argv: list[str]) -> int:
+    """Entry of the psi = t run's process (see _Baseline)."""
+    import argparse
+
+    from drake_standup.config import parse_scenario
+
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--baseline-dir", type=Path, required=True)
+    parser.add_argument("--controller", required=True)
+    parser.add_argument("--chunk", type=float, required=True)
+    args = parser.parse_args(argv)
+    scenario = parse_scenario((args.baseline_dir / "scenario.yaml").read_text(), "baseline")
     result = _simulate_one(
         scenario,
-        out_dir,
-        record=record,
-        progress=progress,
-        chunk_s=chunk_s,
-        label="simulating",
-        baseline=base,
-        controller=controller,
+        None,
+        record=False,
+        progress=False,
+        chunk_s=args.chunk,
+        label="baseline (psi = t)",
+        controller=args.controller,
     )
-    return result
+    outputs.write_signals(args.baseline_dir / "signals.npz", result.signals)
+    outputs.write_metrics(args.baseline_dir / "metrics.json", result.metrics)
+    return 0
 
 
 def _human_acts(scenario: Scenario) -> bool:
@@ -116,7 +199,7 @@ def _simulate_one(
     chunk_s: float,
     label: str,
     controller: str,
-    baseline: RunResult | None = None,
+    baseline: _Baseline | None = None,
 ) -> RunResult:
     meshcat = make_meshcat() if record else None
     t_build = time.perf_counter()
@@ -182,10 +265,10 @@ def _simulate_one(
     )
     result.metrics = {k: result.metrics[k] for k in _ordered(result.metrics)}
 
+    base = None
     if baseline is not None:
-        result.metrics["standup_time_s_without_advancement"] = baseline.metrics.get(
-            "standup_time_s"
-        )
+        base = baseline.result()
+        result.metrics["standup_time_s_without_advancement"] = base.metrics.get("standup_time_s")
     if out_dir is not None:
         out_dir = Path(out_dir)
         out_dir.mkdir(parents=True, exist_ok=True)
@@ -197,14 +280,17 @@ def _simulate_one(
             result.files["recording"] = path
         for p in outputs.export_diagram(built.diagram, out_dir / "diagrams"):
             result.files[p.suffix.lstrip(".")] = p
+        path = out_dir / "signals.npz"
+        outputs.write_signals(path, result.signals)
+        result.files["signals"] = path
+        # The figures draw what signals.npz holds.
+        signals = outputs.load_signals(path)
         entries = result.metrics.get("state_entry_times_s", [])
         path = out_dir / "figure_advancement.png"
-        outputs.figure_advancement(
-            result.signals, baseline.signals if baseline else None, entries, path
-        )
+        outputs.figure_advancement(signals, base.signals if base else None, entries, path)
         result.files["figure_advancement"] = path
         path = out_dir / "figure_tracking.png"
-        outputs.figure_tracking(result.signals, built.pad_groups, entries, path)
+        outputs.figure_tracking(signals, entries, path)
         result.files["figure_tracking"] = path
         path = out_dir / "metrics.json"
         outputs.write_metrics(path, result.metrics)
@@ -271,26 +357,71 @@ class _FallMonitor:
             )
 
 
+def make_signals(built: StandupDiagram, root_context) -> dict[str, np.ndarray]:
+    """Every logger's series as named arrays on one time grid (rows = samples):
+    what signals.npz holds, and what the metrics and figures are computed from."""
+    logs = {}
+    for name, logger in built.logs.items():
+        log = logger.FindLog(root_context)
+        logs[name] = (log.sample_times(), log.data())
+    t = logs["com_W"][0].copy()
+    for name, (times, _) in logs.items():
+        if not np.array_equal(times, t):
+            raise RuntimeError(f"logger {name} is not on the common time grid")
+
+    def rows(name: str) -> np.ndarray:
+        return logs[name][1].T.copy()
+
+    state = rows("robot_state")
+    nq = built.scene.plant.num_positions(built.scene.robot.model_instance)
+    joints = built.joints
+    pad_forces = rows("pad_forces_W").reshape(len(t), len(built.pad_groups), 3)
+    segment = rows("segment")
+    reference = rows("com_reference")
+    signals = {
+        "time_s": t,
+        "com_W": rows("com_W"),
+        "com_reference_W": reference[:, 0:3],
+        "com_reference_velocity_W": reference[:, 3:6],
+        "com_reference_acceleration_W": reference[:, 6:9],
+        "psi": rows("psi")[:, 0],
+        "psi_dot": rows("psi_dot")[:, 0],
+        "alpha": rows("alpha")[:, 0],
+        "state": np.rint(rows("standup_state")[:, 0]).astype(np.int8),
+        "segment_psi_entry": segment[:, 0],
+        "segment_psi_length": segment[:, 1],
+        "hand_wrenches_W": rows("hand_wrenches_W"),
+        "pad_names": np.array(list(built.pad_groups), dtype=str),
+        "pad_groups": np.array(list(built.pad_groups.values()), dtype=str),
+        "pad_forces_W": pad_forces,
+        "pad_normal_force_N": pad_forces[:, :, 2].copy(),
+        "base_quaternion_wxyz": state[:, 0:4],
+        "base_position_W": state[:, 4:7],
+        "joint_names": np.array(joints.names, dtype=str),
+        "joint_positions_rad": state[:, joints.q_index],
+        "joint_velocities_rad_per_s": state[:, nq + joints.v_index],
+        "joint_torques_Nm": rows("net_actuation"),
+    }
+    if "controller_diagnostics" in logs:
+        diagnostics = rows("controller_diagnostics")
+        signals["qp_ok"] = diagnostics[:, 0] > 0.5
+        signals["qp_failures"] = diagnostics[:, 1].astype(np.int64)
+    if "push_force_W" in logs:
+        signals["push_force_W"] = rows("push_force_W")
+    return signals
+
+
 def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResult:
     """Reads every logger and turns the signals into metrics."""
     plant = built.scene.plant
     instance = built.scene.robot.model_instance
-    signals = {}
-    for name, logger in built.logs.items():
-        log = logger.FindLog(root_context)
-        signals[name] = (log.sample_times().copy(), log.data().copy())
-    result = RunResult({}, signals=signals, pad_groups=dict(built.pad_groups))
+    signals = make_signals(built, root_context)
+    result = RunResult({}, signals=signals)
     # The model's (nominal) mass, which the controller knows, and the simulated
     # one (perturbation.mass_scale), whose weight the contacts carry.
     mass_kg = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
     simulated_mass_kg = plant.CalcTotalMass(plant.GetMyContextFromRoot(root_context), [instance])
-    metrics = outputs.seated_metrics(
-        result.times_s,
-        result.com_W,
-        result.pad_forces_W,
-        built.pad_groups,
-        weight_N=simulated_mass_kg * GRAVITY_MPS2,
-    )
+    metrics = outputs.seated_metrics(signals, weight_N=simulated_mass_kg * GRAVITY_MPS2)
     metrics["robot_mass_kg"] = mass_kg
     metrics["simulated_mass_kg"] = simulated_mass_kg
     entry_times = built.state_machine.mode(
@@ -299,14 +430,15 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
     psi_now = built.advancement.GetOutputPort("psi").Eval(
         built.advancement.GetMyContextFromRoot(root_context)
     )[0]
-    metrics.update(outputs.advancement_metrics(psi_now, signals["psi_dot"][1][0], entry_times))
-    metrics.update(
-        outputs.standup_metrics(signals, built.pad_groups, metrics["state_entry_times_s"])
-    )
-    if "controller_diagnostics" in signals:
-        diagnostics = signals["controller_diagnostics"][1]
-        metrics["qp_failures"] = int(diagnostics[1, -1]) if diagnostics.size else 0
-    torques = signals["net_actuation"][1]
+    metrics.update(outputs.advancement_metrics(psi_now, signals["psi_dot"], entry_times))
+    metrics.update(outputs.standup_metrics(signals, metrics["state_entry_times_s"]))
+    if "qp_failures" in signals:
+        metrics["qp_failures"] = int(signals["qp_failures"][-1]) if len(signals["time_s"]) else 0
+    torques = signals["joint_torques_Nm"]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
     result.metrics = metrics
     return result
+
+
+if __name__ == "__main__":
+    sys.exit(_baseline_main(sys.argv[1:]))

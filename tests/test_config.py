@@ -50,6 +50,15 @@ BAD = {
     "nested_inf": ("initial:\n  base_xyz_m: [0.0, .inf, 0.4]\n", "initial.base_xyz_m[1]"),
     "unknown_model": ("robot:\n  model: NoSuchRobot\n", "robot.model"),
     "nan_in_drake_config": ("plant:\n  time_step: .nan\n", "plant.time_step"),
+    "controller_faster_than_plant": (
+        "plant:\n  time_step: 0.005\ncontroller_period_s: 0.001\n",
+        "controller_period_s",
+    ),
+    "controller_off_the_plant_grid": (
+        "plant:\n  time_step: 0.004\ncontroller_period_s: 0.006\n",
+        "controller_period_s",
+    ),
+    "zero_integrator_step": ("simulator:\n  max_step_size: 0\n", "simulator.max_step_size"),
 }
 
 
@@ -125,3 +134,14 @@ def test_cli_rejects_wrongly_typed_scenario(tmp_path):
     assert proc.returncode == 2, proc.stderr
     assert len(proc.stderr.splitlines()) == 1, proc.stderr
     assert proc.stderr.startswith("error:")
+
+
+@pytest.mark.parametrize(
+    ("time_step", "period"), [(0.001, 0.001), (0.002, 0.004), (0.004, 0.008), (0.001, 0.01)]
+)
+def test_controller_period_on_the_plant_grid_is_accepted(tmp_path, time_step, period):
+    """Whole multiples of the plant step (1x, 2x, 10x) load, values unchanged."""
+    path = tmp_path / "ok.yaml"
+    path.write_text(f"plant:\n  time_step: {time_step}\ncontroller_period_s: {period}\n")
+    scenario = load_scenario(path)
+    assert (scenario.plant.time_step, scenario.controller_period_s) == (time_step, period)

@@ -42,8 +42,8 @@ def test_com_stays_put_after_settling(seated_run):
     """After the first 0.5 s the CoM moves less than 1 cm."""
     _, result, _ = seated_run
     after = result.times_s >= 0.5
-    com = result.com_W[:, after]
-    drift = np.linalg.norm(com - com[:, :1], axis=0).max()
+    com = result.com_W[after]
+    drift = np.linalg.norm(com - com[:1], axis=1).max()
     assert drift < 0.01
     assert result.metrics["com_drift_after_settle_m"] == pytest.approx(drift)
 
@@ -54,9 +54,9 @@ def test_contact_forces_carry_the_robot_weight(seated_run):
     scenario, result, _ = seated_run
     weight = _urdf_mass_kg(scenario.robot.model) * G
     late = result.times_s >= 1.0
-    total = result.pad_forces_W.sum(axis=0)[:, late]  # (3, N)
-    assert np.all(np.abs(total[2] - weight) < 0.02 * weight)
-    assert np.all(np.abs(total[:2]) < 0.02 * weight)
+    total = result.pad_forces_W.sum(axis=1)[late]  # (N, 3)
+    assert np.all(np.abs(total[:, 2] - weight) < 0.02 * weight)
+    assert np.all(np.abs(total[:, :2]) < 0.02 * weight)
     groups = result.metrics["contact_normal_force_N"]
     assert set(groups) == {"soles", "thighs", "buttocks"}
     for name, fz in groups.items():
@@ -67,7 +67,7 @@ def test_only_the_pads_touch_anything(seated_run):
     """The robot's only collision geometries are the five pads, and every one
     of them is in contact at the end (the pose really rests on chair and floor)."""
     _, result, _ = seated_run
-    final = result.pad_forces_W[:, 2, -1]
+    final = result.pad_forces_W[-1, :, 2]
     assert set(result.pad_names) == {
         "l_sole_pad",
         "r_sole_pad",

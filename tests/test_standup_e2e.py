@@ -2,22 +2,31 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
+from drake_standup.outputs import load_signals
 from drake_standup.simulate import simulate
 
 pytestmark = pytest.mark.slow
 
 
-def _run(name: str, **kw):
+def _run(name: str, out_dir=None, **kw):
     scenario = load_scenario(SCENARIO_DIR / f"{name}.yaml")
-    return scenario, simulate(scenario, None, record=False, progress=False, **kw).metrics
+    return scenario, simulate(scenario, out_dir, record=False, progress=False, **kw).metrics
 
 
 @pytest.fixture(scope="module")
-def unassisted():
-    return _run("unassisted")
+def unassisted_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("unassisted")
+    scenario, metrics = _run("unassisted", out)
+    return scenario, metrics, load_signals(out / "signals.npz")
+
+
+@pytest.fixture(scope="module")
+def unassisted(unassisted_run):
+    return unassisted_run[:2]
 
 
 @pytest.fixture(scope="module")
@@ -57,3 +66,22 @@ def test_unhelpful_pulls_never_advance_and_end_cleanly(name):
     assert m["psi_dot_max"] == 1.0  # a hindering or perpendicular pull never helps
     assert m["psi_final"] == pytest.approx(m["sim_time_s"], abs=1e-9)
     assert m["success"] or m["failure_reason"]
+
+
+def test_signals_npz_gives_the_metrics_back(unassisted_run):
+    """The stand-up read straight off signals.npz, state array and time grid
+    only: state entries to within one log sample of the state machine's own
+    entry times, and the stand-up time (first sample in state 4 with the CoM
+    within 2 cm of its final reference and every seat pad unloaded, counted
+    from the first sample in state 2) to within one sample of the metric."""
+    scenario, m, sig = unassisted_run
+    t, state = sig["time_s"], sig["state"]
+    dt = scenario.log_period_s
+    for k in (2, 3, 4):
+        t_k = t[np.argmax(state >= k)]
+        assert t_k == pytest.approx(m["state_entry_times_s"][k - 1], abs=dt + 1e-9)
+    seat = sig["pad_groups"] != "soles"
+    near = np.linalg.norm(sig["com_W"] - sig["com_reference_W"][-1], axis=1) <= 0.02
+    up = (state == 4) & near & np.all(sig["pad_normal_force_N"][:, seat] < 1.0, axis=1)
+    standup = t[np.argmax(up)] - t[np.argmax(state >= 2)]
+    assert standup == pytest.approx(m["standup_time_s"], abs=dt + 1e-9)

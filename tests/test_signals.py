@@ -1,0 +1,104 @@
+"""signals.npz: the logged time series every run writes beside metrics.json.
+
+Checked against what is known independently of the logging: the seated pose
+the scenario starts from, psi = t when nobody helps, the robot's weight on its
+pads, and the run's own metrics (computed before the file was written).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from drake_standup.outputs import load_signals, write_signals
+
+pytestmark = pytest.mark.slow
+
+LISTED = {  # issue 11: the arrays a user can rely on, with their shapes
+    "time_s": ("N",),
+    "com_W": ("N", 3),
+    "com_reference_W": ("N", 3),
+    "psi": ("N",),
+    "psi_dot": ("N",),
+    "state": ("N",),
+    "hand_wrenches_W": ("N", 12),
+    "pad_normal_force_N": ("N", "P"),
+    "pad_names": ("P",),
+    "pad_groups": ("P",),
+    "joint_positions_rad": ("N", "J"),
+    "joint_names": ("J",),
+    "joint_torques_Nm": ("N", "J"),
+}
+
+
+@pytest.fixture(scope="module")
+def seated(seated_run):
+    scenario, result, out = seated_run
+    return scenario, result, load_signals(out / "signals.npz")
+
+
+def test_every_listed_array_with_its_shape(seated):
+    scenario, _, sig = seated
+    n = round(scenario.duration_s / scenario.log_period_s)
+    sizes = {"N": n, "P": 5, "J": 32}
+    for name, shape in LISTED.items():
+        assert name in sig, name
+        assert sig[name].shape == tuple(sizes.get(d, d) for d in shape), name
+    # One time grid, the loggers' period, from 0.
+    np.testing.assert_allclose(np.diff(sig["time_s"]), scenario.log_period_s, atol=1e-12)
+    assert sig["time_s"][0] == 0.0
+
+
+def test_names_and_groups_match_the_model(seated):
+    scenario, _, sig = seated
+    names = [str(n) for n in sig["joint_names"]]
+    assert len(set(names)) == 32 and set(scenario.initial.joints_rad) <= set(names)
+    groups = dict(zip(sig["pad_names"], sig["pad_groups"]))
+    assert groups == {
+        "l_sole_pad": "soles",
+        "r_sole_pad": "soles",
+        "l_thigh_pad": "thighs",
+        "r_thigh_pad": "thighs",
+        "buttocks_pad": "buttocks",
+    }
+
+
+def test_joint_positions_start_in_the_scenarios_seated_pose(seated):
+    """Column j at t = 0 is the scenario's angle for joint_names[j] (by name,
+    so a column mix-up fails; joints the scenario leaves out start at 0)."""
+    scenario, _, sig = seated
+    joints = scenario.initial.joints_rad
+    expected = np.array([joints.get(str(n), 0.0) for n in sig["joint_names"]])
+    np.testing.assert_allclose(sig["joint_positions_rad"][0], expected, atol=1e-4)
+
+
+def test_psi_is_time_and_the_pads_carry_the_weight(seated):
+    _, result, sig = seated
+    np.testing.assert_allclose(sig["psi"], sig["time_s"], atol=1e-9)
+    assert np.all(sig["psi_dot"] == 1.0) and np.all(sig["state"] == 1)
+    late = sig["time_s"] >= 1.0
+    total = sig["pad_normal_force_N"][late].sum(axis=1)
+    np.testing.assert_allclose(total, result.metrics["weight_N"], rtol=0.02)
+    # The normal forces are the z column of the full pad forces.
+    np.testing.assert_array_equal(sig["pad_normal_force_N"], sig["pad_forces_W"][:, :, 2])
+
+
+def test_arrays_agree_with_the_metrics(seated):
+    _, result, sig = seated
+    m = result.metrics
+    np.testing.assert_allclose(sig["com_W"][-1], m["com_final_m"], atol=0)
+    assert np.abs(sig["joint_torques_Nm"]).max() == pytest.approx(m["max_abs_torque_Nm"])
+    assert int(sig["qp_failures"][-1]) == m["qp_failures"]
+    assert sig["psi"][-1] == pytest.approx(m["psi_final"], abs=2 * 0.01)
+
+
+def test_round_trip_keeps_every_array(tmp_path, seated):
+    _, result, sig = seated
+    write_signals(tmp_path / "again.npz", result.signals)
+    again = load_signals(tmp_path / "again.npz")
+    assert again.keys() == sig.keys()
+    for name in sig:
+        np.testing.assert_array_equal(again[name], sig[name])
+    # Plain numpy.load reads it without pickle (strings are unicode arrays).
+    with np.load(tmp_path / "again.npz", allow_pickle=False) as data:
+        assert str(data["pad_names"][0]) == str(sig["pad_names"][0])
