@@ -9,15 +9,18 @@ In one process, --repeat times each:
       --plant-duration simulated seconds (a stationary hold: a few are enough);
   (b) closed_loop_recording: the scenario under the whole-body controller with the
       Meshcat recording on, --duration simulated seconds (default: the scenario's);
-  (c) closed_loop: the same without the recording.
-Then the controller's tick split (WholeBodyController.timing_s()), the plant step
-timed one step at a time, the model build with a cold and a warm mesh cache, peak
-memory and the machine. One JSON summary goes to stdout (and to --out); progress
-goes to stderr. sim_s_per_wall_s is simulate()'s realtime_factor: simulated time
-over the wall time of the simulation loop only. (b) and (c) both write their
-outputs into a temporary directory, so call_wall_s (the whole simulate() call:
-build, loop, metrics, figures, diagram, and for (b) the recording's HTML) differs
-between them by the recording alone.
+  (c) closed_loop: the same without the recording;
+  (d) run_diagram: `python run_diagram.py` as a user runs it, once, in a fresh
+      process: imports, both simulations (the psi = t one beside the main one),
+      the recording and every output; --no-run-diagram skips it.
+Then the controller's tick split (WholeBodyController.timing_s()) and its share of
+the closed loop's wall time, the plant step timed one step at a time, the model
+build with a cold and a warm mesh cache, peak memory and the machine. One JSON
+summary goes to stdout (and to --out); progress goes to stderr. sim_s_per_wall_s is
+simulate()'s realtime_factor: simulated time over the wall time of the simulation
+loop only. (b) and (c) both write their outputs into a temporary directory, so
+call_wall_s (the whole simulate() call: build, loop, metrics, figures, diagram, and
+for (b) the recording's HTML) differs between them by the recording alone.
 
 A benchmark, not a test: the machine is shared and noisy, so read medians and
 ratios, and compare figures from one run of this script only.
@@ -169,7 +172,8 @@ def _step_stats(times_s: list[float]) -> dict:
 
 
 def _plant_step(scenario: Scenario, steps: int) -> dict:
-    """Wall time per 1 ms step of the seated hold, one AdvanceTo per step:
+    """Wall time per plant step (plant.time_step) of the seated hold, one
+    AdvanceTo per step:
     the bare plant and scene graph under the joint PD (fixed set point and gravity
     feed-forward), and the whole seat-hold diagram of (a)."""
     step_s = scenario.plant.time_step
@@ -197,6 +201,45 @@ def _plant_step(scenario: Scenario, steps: int) -> dict:
         "step_s": step_s,
         "plant_and_scene_graph_us": _step_stats(plant_only),
         "seat_hold_diagram_us": _step_stats(diagram),
+    }
+
+
+def _tick_share(results: list[RunResult], scenario: Scenario) -> dict:
+    """The controller's share of the closed loop's wall time: its ticks' total
+    compute time over the loop's wall time, per run (median over runs)."""
+    shares = [float(r.controller_timing_s[:, -1].sum()) / r.metrics["wall_time_s"] for r in results]
+    per_step = [
+        r.metrics["wall_time_s"] / (r.metrics["sim_time_s"] / scenario.plant.time_step)
+        for r in results
+    ]
+    return {
+        "controller_share_of_loop_wall": statistics.median(shares),
+        "loop_wall_per_plant_step_us": 1e6 * statistics.median(per_step),
+        "plant_time_step_s": scenario.plant.time_step,
+        "controller_period_s": scenario.controller_period_s,
+    }
+
+
+def _run_diagram(scenario_path: Path) -> dict:
+    """`python run_diagram.py --scenario PATH --out TMP` in a fresh process: the
+    wall time a user waits for the whole job, and its summary line."""
+    with tempfile.TemporaryDirectory(prefix="bench_run_diagram_") as tmp:
+        t0 = time.perf_counter()
+        done = subprocess.run(
+            [sys.executable, str(REPO_ROOT / "run_diagram.py"), "--scenario", str(scenario_path)]
+            + ["--out", tmp],
+            capture_output=True,
+            text=True,
+            check=False,
+            stdin=subprocess.DEVNULL,
+        )
+        wall_s = time.perf_counter() - t0
+    lines = done.stdout.strip().splitlines()
+    _log(f"(d) run_diagram: {wall_s:.1f} s wall, exit {done.returncode}")
+    return {
+        "wall_s": wall_s,
+        "returncode": done.returncode,
+        "summary_line": lines[-1] if lines else done.stderr.strip()[-300:],
     }
 
 
@@ -335,6 +378,9 @@ def _parser() -> argparse.ArgumentParser:
         default=300,
         help="single steps timed for the plant step; default 300",
     )
+    parser.add_argument(
+        "--no-run-diagram", action="store_true", help="skip (d), the whole run_diagram.py"
+    )
     parser.add_argument("--out", type=Path, help="also write the JSON summary to this file")
     parser.add_argument(
         "--profile",
@@ -392,6 +438,7 @@ def main(argv: list[str] | None = None) -> int:
             outputs=True,
         )
         profile = _profile(scenario, args.profile) if args.profile is not None else None
+        run_diagram = None if args.no_run_diagram else _run_diagram(args.scenario)
 
     runs = {
         "plant_seat_hold": _summary(a, closed_loop=False),
@@ -411,6 +458,11 @@ def main(argv: list[str] | None = None) -> int:
             median["closed_loop_recording"] / median["closed_loop"]
         ),
         "controller_tick": {"closed_loop": _tick_split(c), "closed_loop_recording": _tick_split(b)},
+        "controller_share": {
+            "closed_loop": _tick_share(c, scenario),
+            "closed_loop_recording": _tick_share(b, scenario),
+        },
+        "run_diagram": run_diagram,
         "plant_step": plant_step,
         "model_build": build,
         "profile": profile,

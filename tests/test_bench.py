@@ -13,6 +13,7 @@ import statistics
 import pytest
 
 from drake_standup import bench
+from drake_standup.config import Scenario
 from drake_standup.controller import WholeBodyController
 
 DURATION_S = 0.05
@@ -27,6 +28,7 @@ TINY = [
     str(REPEAT),
     "--plant-steps",
     str(PLANT_STEPS),
+    "--no-run-diagram",
 ]
 RUNS = ("plant_seat_hold", "closed_loop_recording", "closed_loop")
 COLUMNS = [name.removesuffix("_s") + "_us" for name in WholeBodyController.TIMING]
@@ -101,7 +103,8 @@ def test_controller_tick_split(tiny):
     for name in ("closed_loop", "closed_loop_recording"):
         split = summary["controller_tick"][name]
         # One tick per controller period plus the initialization tick, each run.
-        assert split["ticks"] == REPEAT * (round(DURATION_S / 0.001) + 1)
+        period = Scenario().controller_period_s
+        assert split["ticks"] == REPEAT * (round(DURATION_S / period) + 1)
         for column in COLUMNS:
             stats = split[column]
             assert 0.0 < stats["median"] <= stats["p95"]
@@ -113,6 +116,21 @@ def test_controller_tick_split(tiny):
         assert parts <= total * (1 + 1e-9)
         assert split["unaccounted_us"]["mean"] == pytest.approx(total - parts, rel=1e-6)
         assert parts > 0.5 * total  # the named parts are most of the tick
+
+
+def test_controller_share_of_the_loop(tiny):
+    """The ticks' summed compute time is part of the loop's wall time (share in
+    (0, 1)); wall per plant step = loop wall / (simulated time / step)."""
+    summary = json.loads(tiny[1])
+    assert summary["run_diagram"] is None  # --no-run-diagram
+    for name in ("closed_loop", "closed_loop_recording"):
+        share = summary["controller_share"][name]
+        assert 0.0 < share["controller_share_of_loop_wall"] < 1.0
+        step = share["plant_time_step_s"]
+        walls = summary[name]["loop_wall_s"]
+        sims = summary[name]["sim_time_s"]
+        expected = statistics.median(1e6 * w / (t / step) for w, t in zip(walls, sims))
+        assert share["loop_wall_per_plant_step_us"] == pytest.approx(expected)
 
 
 def test_plant_step_model_build_memory_and_machine(tiny):
