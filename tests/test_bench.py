@@ -137,7 +137,7 @@ def test_controller_share_of_the_loop(tiny):
 def test_plant_step_model_build_memory_and_machine(tiny):
     summary = json.loads(tiny[1])
     step = summary["plant_step"]
-    assert step["step_s"] == 0.001
+    assert step["step_s"] == Scenario().plant.time_step
     bare, whole = step["plant_and_scene_graph_us"], step["seat_hold_diagram_us"]
     for stats in (bare, whole):
         assert stats["steps"] == PLANT_STEPS
