@@ -24,6 +24,7 @@ reference where the help has already brought the robot.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from pydrake.systems.framework import BasicVector, Context, ContinuousState, LeafSystem
@@ -51,14 +52,18 @@ def psi_dot_law(
     com_velocity: np.ndarray,
     omega_f: np.ndarray,
     tangent: np.ndarray,
-    lead_m: float = 0.0,
+    lead_m: float | Callable[[], float] = 0.0,
 ) -> tuple[float, float]:
-    """(psi_dot, alpha) by the configured update law; lead_m feeds the lead gate."""
+    """(psi_dot, alpha) by the configured update law; lead_m feeds the lead gate
+    (or a function giving it, called only when the gate decides)."""
     alpha = helpfulness(tangent, omega_f, config.eps)
     if not config.enabled or alpha <= config.alpha_min_mps2:
         return 1.0, alpha
-    if config.lead_gate and lead_m < -config.lag_tolerance_m:
-        return 1.0, alpha
+    if config.lead_gate:
+        if callable(lead_m):
+            lead_m = lead_m()
+        if lead_m < -config.lag_tolerance_m:
+            return 1.0, alpha
     if config.law == "tangent":
         ratio = float(com_velocity @ tangent) / (float(tangent @ tangent) + config.eps)
     else:
@@ -118,7 +123,8 @@ class TrajectoryAdvancement(LeafSystem):
             self._v.Eval(context),
             self._omega_f.Eval(context),
             tangent,
-            lead(self._com.Eval(context), self._x_d.Eval(context), tangent),
+            # Only while the interaction helps (a few seconds of a stand-up).
+            lambda: lead(self._com.Eval(context), self._x_d.Eval(context), tangent),
         )
 
     def _psi_ddot(self, context: Context, psi_dot: float) -> float:

@@ -93,9 +93,14 @@ class HumanWrenchSource(LeafSystem):
             self._start_index = self.DeclareDiscreteState(6)
             self.DeclareInitializationDiscreteUpdateEvent(self._CaptureStart)
             prereq |= {self._state.ticket(), self.all_state_ticket()}
-        # Both outputs read one evaluation of the human per time (and state).
-        self._forces_cache = declare_cached(self, "hand forces", self._forces, prereq)
-        prereq = {self._forces_cache.ticket()}
+        # The scripted pulls are a function of time alone: the last time and
+        # its wrenches, because the integrator sets each step's end time twice
+        # (its last stage, then the step's end), which Drake counts as a change.
+        self._last_scripted: tuple[float, np.ndarray] | None = None
+        # Both outputs read one evaluation of the human per time (and state):
+        # hand_wrenches_W itself, (12,).
+        self._wrenches_cache = declare_cached(self, "hand wrenches", self._wrenches, prereq)
+        prereq = {self._wrenches_cache.ticket()}
         self.DeclareVectorOutputPort(
             "hand_wrenches_W", 12, self._CalcWrenches, prerequisites_of_calc=prereq
         )
@@ -120,6 +125,7 @@ class HumanWrenchSource(LeafSystem):
         discrete_state.set_value(self._start_index, np.concatenate(p))
 
     def _forces(self, context: Context) -> np.ndarray:
+        """(2, 3) world forces on the left and right hand. N."""
         t = context.get_time()
         if self._cfg.mode == "scripted":
             return scripted_forces(self._cfg.pulls, t)
@@ -132,15 +138,28 @@ class HumanWrenchSource(LeafSystem):
             [reactive_force(self._cfg.reactive, t, p[i], v[i], start[i]) for i in range(2)]
         )
 
+    def _wrenches(self, context: Context) -> np.ndarray:
+        """hand_wrenches_W (12,): [0, f_l, 0, f_r]."""
+        scripted = self._cfg.mode == "scripted"
+        if scripted and self._last_scripted is not None:
+            t, wrenches = self._last_scripted
+            if t == context.get_time():
+                return wrenches
+        wrenches = np.zeros(12)
+        wrenches.reshape(2, 6)[:, 3:] = self._forces(context)
+        if scripted:
+            self._last_scripted = context.get_time(), wrenches
+        return wrenches
+
     def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
-        f = self._forces_cache.Eval(context)
-        output.SetFromVector(np.concatenate([np.zeros(3), f[0], np.zeros(3), f[1]]))
+        output.SetFromVector(self._wrenches_cache.Eval(context))
 
     def _CalcSpatialForces(self, context: Context, output) -> None:
         """One force per pulled hand (none while nobody pulls: the plant then
         has nothing to apply)."""
+        wrenches = self._wrenches_cache.Eval(context)
         forces = []
-        for applied, f in zip(self._applied, self._forces_cache.Eval(context)):
+        for applied, f in zip(self._applied, (wrenches[3:6], wrenches[9:12])):
             if f.any():
                 applied.F_Bq_W = SpatialForce(np.zeros(3), f)
                 forces.append(applied)

@@ -5,11 +5,13 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from pathlib import Path
 
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, SceneGraph
 from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Context, DiagramBuilder
 
 from drake_standup.config import REPO_ROOT, Scenario, _resolve
@@ -56,8 +58,8 @@ def add_scene(
         visual_max_faces=scenario.robot.visual_max_faces,
     )
     parser = Parser(plant)
-    (floor,) = parser.AddModels(str(MODELS_DIR / "floor.sdf"))
-    (chair,) = parser.AddModels(str(_resolve(scenario.chair.file)))
+    (floor,) = _add_sdf(parser, MODELS_DIR / "floor.sdf")
+    (chair,) = _add_sdf(parser, _resolve(scenario.chair.file))
     world = plant.world_frame()
     plant.WeldFrames(world, plant.GetFrameByName("floor", floor))
     plant.WeldFrames(
@@ -76,6 +78,18 @@ def add_scene(
         CollisionFilterDeclaration().ExcludeWithin(robot_geometries)
     )
     return Scene(plant, scene_graph, robot)
+
+
+def _add_sdf(parser: Parser, path: Path) -> list[ModelInstanceIndex]:
+    """Adds the models of an SDF file. One that names no other file (no <uri>:
+    meshes, includes) is parsed from its text: libsdformat loads its whole
+    schema again for every file it opens but not for a string (measured: 21 ms
+    against 0.5 ms for the floor; the two files were 70% of build_diagram).
+    Files with a <uri> stay files, so that their relative paths resolve."""
+    text = path.read_text()
+    if "<uri>" in text:
+        return parser.AddModels(str(path))
+    return parser.AddModelsFromString(text, "sdf")
 
 
 def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -> None:

@@ -32,9 +32,10 @@ class RobotSensing(LeafSystem):
     heel_x_W (1, m: the front-most of the two soles' heel edges, so "CoM ahead
     of the heels" holds for both feet).
 
-    The kinematic outputs share one cache entry that depends on robot_state
-    only: the plant context is set once per new state (once per plant step),
-    not once per output and integrator stage.
+    The CoM outputs share one cache entry that depends on robot_state only:
+    the plant context is set once per new state (once per plant step), not
+    once per output and integrator stage. heel_x_W has its own: only the state
+    machine reads it, at its own (slower) rate.
     """
 
     def __init__(self, plant: MultibodyPlant, robot: Robot, heel_points: dict[str, np.ndarray]):
@@ -42,39 +43,56 @@ class RobotSensing(LeafSystem):
         self._plant = plant
         self._instance = robot.model_instance
         self._context = plant.CreateDefaultContext()
+        self._context_state: np.ndarray | None = None  # robot_state in self._context
         self._mass_kg = plant.CalcTotalMass(self._context, [self._instance])
         self._heels = [(robot.frame(plant, s), np.asarray(p)) for s, p in heel_points.items()]
         nx = plant.num_multibody_states(self._instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         self._wrenches = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         state_only = {self._state.ticket()}
-        self._kinematics = declare_cached(self, "com and heels", self._calc_kinematics, state_only)
+        self._kinematics = declare_cached(self, "com", self._calc_kinematics, state_only)
         depends = {self._kinematics.ticket()}
-        for name, size, index in (("com_W", 3, 0), ("com_velocity_W", 3, 1), ("heel_x_W", 1, 2)):
+        for name, index in (("com_W", 0), ("com_velocity_W", 1)):
             self.DeclareVectorOutputPort(
-                name, size, self._reader(index), prerequisites_of_calc=depends
+                name, 3, self._reader(index), prerequisites_of_calc=depends
             )
+        self.DeclareVectorOutputPort(
+            "heel_x_W", 1, self._CalcHeelX, prerequisites_of_calc=state_only
+        )
         self.DeclareVectorOutputPort(
             "omega_f_W", 3, self._CalcOmegaF, prerequisites_of_calc={self._wrenches.ticket()}
         )
 
-    def _calc_kinematics(self, context: Context) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _set_plant_state(self, context: Context, check: bool) -> None:
+        """The private plant context at robot_state (check: unless it is there
+        already, so that its kinematics are not computed twice)."""
+        state = self._state.Eval(context)
+        if not (check and np.array_equal(state, self._context_state)):
+            self._plant.SetPositionsAndVelocities(self._context, self._instance, state)
+            self._context_state = state
+
+    def _calc_kinematics(self, context: Context) -> tuple[np.ndarray, np.ndarray]:
+        self._set_plant_state(context, check=False)
         plant, c = self._plant, self._context
-        plant.SetPositionsAndVelocities(c, self._instance, self._state.Eval(context))
-        world = plant.world_frame()
         com = plant.CalcCenterOfMassPositionInWorld(c, [self._instance])
         com_velocity = plant.CalcCenterOfMassTranslationalVelocityInWorld(c, [self._instance])
-        xs = [
-            plant.CalcPointsPositions(c, frame, p.reshape(3, 1), world)[0, 0]
-            for frame, p in self._heels
-        ]
-        return com, com_velocity, np.array([max(xs)] if xs else [np.nan])
+        return com, com_velocity
 
     def _reader(self, index: int):
         def calc(context: Context, output: BasicVector) -> None:
             output.SetFromVector(self._kinematics.Eval(context)[index])
 
         return calc
+
+    def _CalcHeelX(self, context: Context, output: BasicVector) -> None:
+        self._set_plant_state(context, check=True)
+        plant, c = self._plant, self._context
+        world = plant.world_frame()
+        xs = [
+            plant.CalcPointsPositions(c, frame, p.reshape(3, 1), world)[0, 0]
+            for frame, p in self._heels
+        ]
+        output.SetAtIndex(0, max(xs) if xs else np.nan)
 
     def _CalcOmegaF(self, context: Context, output: BasicVector) -> None:
         """Omega f = J_com M^-1 sum_h J_h^T F_h (paper, Sec. II).

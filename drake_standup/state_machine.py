@@ -42,6 +42,16 @@ class StandupMode:
     x_start_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     delta_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
+    def __copy__(self) -> StandupMode:
+        return self
+
+    def __deepcopy__(self, memo: dict) -> StandupMode:
+        """Itself: the mode is immutable. Drake clones the abstract state (a
+        Python deepcopy) into and out of its scratch state at every
+        unrestricted update of the diagram, i.e. at every plant step: real
+        copies cost ~15 us a step (measured)."""
+        return self
+
     def segment(self) -> np.ndarray:
         return np.array([self.psi_entry, self.segment_psi, *self.x_start_m, *self.delta_m])
 
