@@ -158,11 +158,14 @@ def build_diagram(
     visualizer = None
     if meshcat is not None:
         vis = scenario.visualization
+        step_s = scenario.plant.time_step
         visualizer = MeshcatVisualizer.AddToBuilder(
             builder,
             scene.scene_graph,
             meshcat,
-            MeshcatVisualizerParams(publish_period=vis.publish_period_s, role=Role.kIllustration),
+            MeshcatVisualizerParams(
+                publish_period=on_step_grid(vis.publish_period_s, step_s), role=Role.kIllustration
+            ),
         )
         if vis.show_contact_forces:
             ContactVisualizer.AddToBuilder(
@@ -170,7 +173,8 @@ def build_diagram(
                 plant,
                 meshcat,
                 ContactVisualizerParams(
-                    publish_period=vis.contact_publish_period_s, newtons_per_meter=400.0
+                    publish_period=on_step_grid(vis.contact_publish_period_s, step_s),
+                    newtons_per_meter=400.0,
                 ),
             )
 
@@ -187,6 +191,16 @@ def build_diagram(
         logs,
         visualizer,
     )
+
+
+def on_step_grid(period_s: float, step_s: float) -> float:
+    """period_s rounded to a whole number (>= 1) of plant steps (step_s 0: a
+    continuous plant, unchanged). A visualizer that publishes between the
+    plant's steps splits an integrator step of psi, so a recording would
+    change the simulation it records."""
+    if step_s <= 0.0:
+        return period_s
+    return step_s * max(1, round(period_s / step_s))
 
 
 def _add_perturbations(

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 import shutil
 import subprocess
 import sys
@@ -225,10 +226,18 @@ def _simulate_one(
     failure_reason = None
     bar = ProgressBar(scenario.duration_s, label) if progress else None
     t_wall = time.perf_counter()
+    # Chunk ends on the plant's step grid: an end a rounding error off an
+    # event time makes the integrator take a ~1e-17 s step (measured: 8% more
+    # integrator steps at 5 ms).
+    step_s = scenario.plant.time_step
+    if step_s > 0.0:
+        chunk_s = step_s * max(1, round(chunk_s / step_s))
     try:
         simulator.Initialize()
+        chunk = 0
         while root_context.get_time() < scenario.duration_s - 1e-9:
-            target = min(root_context.get_time() + chunk_s, scenario.duration_s)
+            chunk += 1
+            target = min(chunk * chunk_s, scenario.duration_s)
             status = simulator.AdvanceTo(target)
             elapsed = time.perf_counter() - t_wall
             if bar is not None:
@@ -318,6 +327,9 @@ class _FallMonitor:
         self._max_xy = scenario.fall.max_com_horizontal_m
         self._xy0 = np.array(scenario.initial.base_xyz_m[:2])
         self._controller = built.controller
+        self._diagnostics = (
+            None if built.controller is None else built.controller.GetOutputPort("diagnostics")
+        )
         self._max_streak_s = scenario.fall.max_qp_failure_streak_s
         self._failing_since: float | None = None
         self.reason: str | None = None
@@ -331,9 +343,9 @@ class _FallMonitor:
                 f"fall: root_link height {p_WB[2]:.3f} m < {self._min_z} m "
                 f"at t = {root_context.get_time():.3f} s"
             )
-        elif np.linalg.norm(p_WB[:2] - self._xy0) > self._max_xy:
+        elif (moved := math.hypot(p_WB[0] - self._xy0[0], p_WB[1] - self._xy0[1])) > self._max_xy:
             self.reason = (
-                f"fall: root_link moved {np.linalg.norm(p_WB[:2] - self._xy0):.3f} m "
+                f"fall: root_link moved {moved:.3f} m "
                 f"horizontally at t = {root_context.get_time():.3f} s"
             )
         elif self._controller is not None:
@@ -345,7 +357,7 @@ class _FallMonitor:
     def _check_qp(self, root_context) -> None:
         t = root_context.get_time()
         context = self._controller.GetMyContextFromRoot(root_context)
-        qp_ok = self._controller.GetOutputPort("diagnostics").Eval(context)[0]
+        qp_ok = self._diagnostics.Eval(context)[0]
         if qp_ok:
             self._failing_since = None
         elif self._failing_since is None:

@@ -39,7 +39,9 @@ def seated(seated_run):
 
 def test_every_listed_array_with_its_shape(seated):
     scenario, _, sig = seated
-    n = round(scenario.duration_s / scenario.log_period_s)
+    # The whole run, every log period: up to its end (the end itself logged or not).
+    n = len(sig["time_s"])
+    assert sig["time_s"][-1] > scenario.duration_s - scenario.log_period_s - 1e-9
     sizes = {"N": n, "P": 5, "J": 32}
     for name, shape in LISTED.items():
         assert name in sig, name
@@ -102,3 +104,40 @@ def test_round_trip_keeps_every_array(tmp_path, seated):
     # Plain numpy.load reads it without pickle (strings are unicode arrays).
     with np.load(tmp_path / "again.npz", allow_pickle=False) as data:
         assert str(data["pad_names"][0]) == str(sig["pad_names"][0])
+
+
+def test_a_recording_does_not_change_the_simulation():
+    """Meshcat's publishes sit on the plant's step grid (diagram.on_step_grid),
+    so the same 0.6 s of the assisted scenario, with the pull from 0.1 s, is
+    bitwise the same with and without the recording."""
+    from drake_standup.config import SCENARIO_DIR, load_scenario
+    from drake_standup.simulate import simulate
+
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
+    scenario.duration_s = 0.6
+    for pull in scenario.human.pulls:
+        pull.start_s = 0.1
+    plain = simulate(scenario, None, record=False, progress=False).signals
+    recorded = simulate(scenario, None, record=True, progress=False).signals
+    assert plain.keys() == recorded.keys()
+    for name in plain:
+        np.testing.assert_array_equal(recorded[name], plain[name], err_msg=name)
+
+
+@pytest.mark.parametrize(
+    ("period", "step", "expected"),
+    [
+        (1 / 30, 0.004, 0.032),
+        (0.04, 0.004, 0.04),
+        (0.1, 0.004, 0.1),
+        (0.001, 0.004, 0.004),
+        (1 / 30, 0.0, 1 / 30),
+    ],
+)
+def test_publish_periods_land_on_whole_plant_steps(period, step, expected):
+    from drake_standup.diagram import on_step_grid
+
+    result = on_step_grid(period, step)
+    assert result == pytest.approx(expected, rel=1e-12)
+    if step > 0:
+        assert abs(result / step - round(result / step)) < 1e-9
