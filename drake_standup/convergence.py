@@ -772,7 +772,6 @@ def run_study(
 ) -> StudyResult:
     """Simulates what OUT/runs/ does not hold yet, compares, chooses, reports."""
     from drake_standup.outputs import json_safe
-    from drake_standup.progress import ProgressBar
 
     out_dir = Path(out_dir)
     runs_dir = out_dir / "runs"
@@ -789,17 +788,23 @@ def run_study(
 
     for case in todo:  # not finished until its worker says so
         (runs_dir / case.name / "inputs.json").unlink(missing_ok=True)
+
+    def on_result(case: Case, metrics: dict | None, lost: BaseException | None) -> dict:
+        if lost is not None:
+            metrics = {"success": False, "failure_reason": f"cluster: {lost!r}"[:300]}
+            _write_json(runs_dir / case.name / "metrics.json", metrics)
+        return metrics
+
     t0 = time.perf_counter()
     if todo:
-        from distributed import as_completed
+        from drake_standup.sweep import run_on_cluster
 
-        from drake_standup.sweep import open_client
-
-        client, cluster = open_client(workers, address)
-        try:
-            futures = {
-                client.submit(
-                    run_case,
+        tasks = [
+            (
+                c,
+                f"convergence-{c.name}-{inputs[c]['hash']}",
+                run_case,
+                (
                     texts[c.scenario],
                     f"scenarios/{c.scenario}.yaml",
                     c.step_s,
@@ -807,35 +812,18 @@ def run_study(
                     durations[c.scenario],
                     str((runs_dir / c.name).resolve()),
                     inputs[c],
-                    key=f"convergence-{c.name}-{inputs[c]['hash']}",
-                    pure=False,
-                ): c
-                for c in todo
-            }
-            bar = ProgressBar(len(todo), "convergence", unit="runs") if progress else None
-            done = failed = 0
-            for future in as_completed(futures):
-                case = futures[future]
-                if future.status == "finished":
-                    metrics = future.result()
-                else:  # the cluster lost the task (a dead worker): not the run's fault
-                    exc = future.exception()
-                    metrics = {"success": False, "failure_reason": f"cluster: {exc!r}"[:300]}
-                    _write_json(runs_dir / case.name / "metrics.json", metrics)
-                done += 1
-                failed += not metrics.get("success", False)
-                future.release()
-                if bar is not None:
-                    rate = 60.0 * done / (time.perf_counter() - t0)
-                    bar.update(
-                        done, f"last {case.name}; {failed} did not stand up; {rate:.1f} runs/min"
-                    )
-            if bar is not None:
-                bar.close()
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+                ),
+            )
+            for c in todo
+        ]
+        run_on_cluster(
+            tasks,
+            on_result,
+            workers=workers,
+            address=address,
+            label="convergence",
+            progress=progress,
+        )
     wall_s = time.perf_counter() - t0
 
     runs = {c: load_run(runs_dir / c.name) for c in cases}

@@ -111,8 +111,8 @@ class _Baseline:
     """The psi = t run, simulated beside the main run in a Python process of
     its own (on two cores it then costs no wall time). The scenario goes to
     it as YAML, signals.npz and metrics.json come back through a temporary
-    folder. Where that process cannot run (e.g. inside a daemonic Dask
-    worker, or it fails), the run is simulated here instead."""
+    folder. Where that process fails (a notice gives its last error line),
+    the run is simulated here instead."""
 
     def __init__(self, scenario: Scenario, controller: str, chunk_s: float):
         self._scenario = scenario
@@ -142,15 +142,7 @@ class _Baseline:
                 " simulating it here",
                 file=sys.stderr,
             )
-            return _simulate_one(
-                self._scenario,
-                None,
-                record=False,
-                progress=False,
-                chunk_s=self._chunk_s,
-                label="baseline (psi = t)",
-                controller=self._controller,
-            )
+            return _simulate_baseline(self._scenario, self._controller, self._chunk_s)
         finally:
             shutil.rmtree(self._dir, ignore_errors=True)
 
@@ -159,6 +151,19 @@ class _Baseline:
         self._process.wait()
         self._stderr.close()
         shutil.rmtree(self._dir, ignore_errors=True)
+
+
+def _simulate_baseline(scenario: Scenario, controller: str, chunk_s: float) -> RunResult:
+    """The psi = t run itself: no recording, no progress bar, no outputs."""
+    return _simulate_one(
+        scenario,
+        None,
+        record=False,
+        progress=False,
+        chunk_s=chunk_s,
+        label="baseline (psi = t)",
+        controller=controller,
+    )
 
 
 def _baseline_main(argv: list[str]) -> int:
@@ -173,15 +178,7 @@ def _baseline_main(argv: list[str]) -> int:
     parser.add_argument("--chunk", type=float, required=True)
     args = parser.parse_args(argv)
     scenario = parse_scenario((args.baseline_dir / "scenario.yaml").read_text(), "baseline")
-    result = _simulate_one(
-        scenario,
-        None,
-        record=False,
-        progress=False,
-        chunk_s=args.chunk,
-        label="baseline (psi = t)",
-        controller=args.controller,
-    )
+    result = _simulate_baseline(scenario, args.controller, args.chunk)
     outputs.write_signals(args.baseline_dir / "signals.npz", result.signals)
     outputs.write_metrics(args.baseline_dir / "metrics.json", result.metrics)
     return 0

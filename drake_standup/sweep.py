@@ -474,6 +474,53 @@ def open_client(workers: int, address: str | None):
     return Client(cluster), cluster
 
 
+def run_on_cluster(
+    tasks: list,
+    on_result,
+    *,
+    workers: int,
+    address: str | None,
+    label: str,
+    progress: bool = True,
+) -> None:
+    """Runs tasks [(item, key, fn, args), ...] on a Dask cluster (open_client)
+    and, as each finishes, calls on_result(item, metrics, lost): metrics is
+    fn's return value (a metrics dict) or None with lost the exception of a
+    task the cluster lost (a dead worker: not the run's fault); on_result
+    returns the metrics to count. A progress bar counts the runs, those not
+    stood up and the rate; the cluster is closed however this ends."""
+    from distributed import as_completed
+
+    from drake_standup.progress import ProgressBar
+
+    client, cluster = open_client(workers, address)
+    try:
+        futures = {
+            client.submit(fn, *args, key=key, pure=False): item for item, key, fn, args in tasks
+        }
+        bar = ProgressBar(len(tasks), label, unit="runs") if progress else None
+        t0 = time.perf_counter()
+        done = failed = 0
+        for future in as_completed(futures):
+            item = futures[future]
+            if future.status == "finished":
+                metrics = on_result(item, future.result(), None)
+            else:
+                metrics = on_result(item, None, future.exception())
+            done += 1
+            failed += not metrics.get("success", False)
+            future.release()
+            if bar is not None:
+                rate = 60.0 * done / (time.perf_counter() - t0)
+                bar.update(done, f"{failed} not stood up; {rate:.1f} runs/min")
+        if bar is not None:
+            bar.close()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
 def run_sweep(
     spec: SweepSpec,
     out_dir: Path,
@@ -484,7 +531,6 @@ def run_sweep(
     limit: int | None = None,
 ) -> SweepResult:
     """Runs what out_dir/runs/ does not hold yet; writes the table and figures."""
-    from drake_standup.progress import ProgressBar
 
     runs = expand(spec)[:limit]
     out_dir = Path(out_dir)
@@ -510,55 +556,35 @@ def run_sweep(
     if progress and records:
         print(f"resuming: {len(records)} of {len(runs)} runs already in {runs_dir}", flush=True)
 
+    def on_result(run: RunSpec, metrics: dict | None, lost: BaseException | None) -> dict:
+        if lost is not None:
+            text = " ".join(str(lost).split())
+            metrics = {
+                "success": False,
+                "failure_reason": f"cluster: {type(lost).__name__}: {text}"[:300],
+            }
+        record = {
+            "index": run.index,
+            "run_id": run.run_id,
+            "params": run.params,
+            "overrides": run.overrides,
+            "metrics": metrics,
+            "retry": lost is not None,
+        }
+        _write_json(runs_dir / f"{run.run_id}.json", record)
+        records[run.run_id] = record
+        return metrics
+
     t0 = time.perf_counter()
     if todo:
-        from distributed import as_completed
-
-        client, cluster = open_client(workers, address)
-        try:
-            futures = {
-                client.submit(
-                    run_one, spec.base_text, run.overrides, key=f"standup-{run.run_id}", pure=False
-                ): run
-                for run in todo
-            }
-            bar = ProgressBar(len(todo), f"sweep {spec.name}", unit="runs") if progress else None
-            done = failed = 0
-            for future in as_completed(futures):
-                run = futures[future]
-                if future.status == "finished":
-                    metrics = future.result()
-                    retry = False
-                else:  # the worker died or the cluster lost the task: not the run's fault
-                    exc = future.exception()
-                    text = " ".join(str(exc).split())
-                    metrics = {
-                        "success": False,
-                        "failure_reason": f"cluster: {type(exc).__name__}: {text}"[:300],
-                    }
-                    retry = True
-                record = {
-                    "index": run.index,
-                    "run_id": run.run_id,
-                    "params": run.params,
-                    "overrides": run.overrides,
-                    "metrics": metrics,
-                    "retry": retry,
-                }
-                _write_json(runs_dir / f"{run.run_id}.json", record)
-                records[run.run_id] = record
-                done += 1
-                failed += not metrics.get("success", False)
-                future.release()
-                if bar is not None:
-                    rate = 60.0 * done / (time.perf_counter() - t0)
-                    bar.update(done, f"{failed} not stood up; {rate:.1f} runs/min")
-            if bar is not None:
-                bar.close()
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+        run_on_cluster(
+            [(r, f"standup-{r.run_id}", run_one, (spec.base_text, r.overrides)) for r in todo],
+            on_result,
+            workers=workers,
+            address=address,
+            label=f"sweep {spec.name}",
+            progress=progress,
+        )
     wall_s = time.perf_counter() - t0
 
     ordered = [records[r.run_id] for r in runs]

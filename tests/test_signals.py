@@ -141,3 +141,27 @@ def test_publish_periods_land_on_whole_plant_steps(period, step, expected):
     assert result == pytest.approx(expected, rel=1e-12)
     if step > 0:
         assert abs(result / step - round(result / step)) < 1e-9
+
+
+def test_the_psi_equals_t_run_in_its_own_process_equals_one_run_here(monkeypatch, capsys):
+    """run_diagram's psi = t run goes to a second process as YAML; the same
+    run simulated in this process (the fallback, forced by a Python that fails
+    at once) gives bitwise the same signals, so the YAML round trip loses
+    nothing of the scenario."""
+    import sys
+
+    from drake_standup.config import SCENARIO_DIR, load_scenario
+    from drake_standup.simulate import _Baseline
+
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
+    scenario.duration_s = 0.8
+    scenario.advancement.enabled = False
+    for pull in scenario.human.pulls:
+        pull.start_s = 0.1
+    there = _Baseline(scenario, "whole_body", 0.05).result()
+    monkeypatch.setattr(sys, "executable", "/bin/false")
+    here = _Baseline(scenario, "whole_body", 0.05).result()
+    assert "simulating it here" in capsys.readouterr().err
+    assert there.signals.keys() == here.signals.keys()
+    for name in here.signals:
+        np.testing.assert_array_equal(there.signals[name], here.signals[name], err_msg=name)
