@@ -4,7 +4,7 @@ python -m drake_standup.convergence [--out DIR] [--workers N] [--scenarios NAME 
     [--steps-ms H ...] [--fresh] [--docs DIR]
 
 A study, not a test. It simulates scenarios/NAME.yaml (assisted, unassisted,
-lateral and seated by default) with the plant stepped at each of 1, 2, 4, 5, 8
+lateral and seated by default) with the plant stepped at each of 0.5, 1, 2, 4, 5, 8
 and 10 ms and the controller at the same period, plus, at 2, 4 and 5 ms, the
 controller at twice the plant step ("does a slower controller over a finer plant
 pay?"). Every run is compared with the same scenario's run at 1 ms against issue 11's
