@@ -63,6 +63,8 @@ def main(argv: list[str] | None = None) -> int:
         outcome = f"stood up in {m['standup_time_s']:.2f} s"
         if m.get("standup_time_s_without_advancement") is not None:
             outcome += f" ({m['standup_time_s_without_advancement']:.2f} s without advancement)"
+        elif "standup_time_s_without_advancement" in m:
+            outcome += " (did not stand up without advancement)"
     else:
         outcome = "did not stand up"
     status = "OK" if m["success"] else f"FAILED ({m['failure_reason']})"
