@@ -1,8 +1,10 @@
 """WholeBodyController: the momentum-based whole-body torque controller (SPEC 2, 3, 7).
 
 A thin LeafSystem around drake_standup/control/: every period_s it reads the robot's
-state, the CoM reference, the contact plan and the measured hand wrenches, solves one QP
-over [contact wrenches, vdot] (control/qp.py) and holds the resulting joint torques.
+state, the CoM reference, the contact plan and the measured hand wrenches, computes the
+tick's references (control/references.py), solves one QP over [contact wrenches, vdot]
+with the task objects of control/tasks.py (control/qp.py) and holds the resulting joint
+torques.
 
 Ports
     robot_state      (nq + nv)  [q (quaternion wxyz, p_WB, joints); v (w_WB, v_WB, joints)]
@@ -20,9 +22,10 @@ on the chair) so that the trunk can bring the CoM over the feet.
 
 Contact plan: seat_scale scales the seat's and thighs' normal-force bounds (the plan
 ramps it to 0 to release the seat; at 0 they are dropped); feet_scale scales the soles'
-minimum normal force (0 drops them). standup_state picks the CoM gains (seated 1-2,
-standing 3-4), the base pitch and the posture reference (state 1: the posture at the
-first tick).
+minimum normal force (0 drops them). standup_state picks, in one table
+(control/references.py: StandupSchedule), the CoM gains (seated 1-2, standing 3-4), the
+base pitch, the posture reference (state 1: the posture at the first tick) and whether
+the seat is hinged.
 """
 
 import math
@@ -37,22 +40,18 @@ from drake_standup.control.contacts import NORMAL, WRENCH_SIZE, ContactSpec
 from drake_standup.control.qp import (
     SOLVERS,
     ContactCommands,
-    QpLayout,
+    ContactMap,
     QpSolution,
     WholeBodyQp,
     as_slice,
 )
-from drake_standup.control.spatial import yaw_pitch_rotation
+from drake_standup.control.references import ReferenceGenerator, StandupSchedule, joint_values
 from drake_standup.control.tasks import (
-    base_orientation_reference,
-    base_orientation_task,
-    com_acceleration_reference,
-    cop_centering_task,
-    helpful_force,
-    joint_limit_acceleration_bounds,
-    momentum_task,
-    posture_acceleration_reference,
-    posture_task,
+    BaseOrientationTask,
+    CopCenteringTask,
+    JointLimitBounds,
+    MomentumTask,
+    PostureTask,
 )
 from drake_standup.control.terms import BASE_BODY, RobotKinematics, RobotTerms
 from drake_standup.robot import Robot
@@ -331,7 +330,26 @@ class WholeBodyController(LeafSystem):
         self.contact_specs = _contact_specs(plant, robot, config)
         held_frames = [spec.frame for spec in self.contact_specs if spec.constrained]
         self._joints = joints = _actuated_joints(plant, robot, held_frames)
-        self._posture_setup(config, joints)
+        self._references = ReferenceGenerator(
+            config,
+            StandupSchedule(config, joints.names, joints.q_min, joints.q_max),
+            as_slice(joints.q_indices),
+            period_s,
+        )
+        self._posture_weights = joint_values(
+            joints.names,
+            config.posture_weight_by_joint,
+            "posture_weight_by_joint",
+            config.posture_weight,
+        )
+        limited = joints.limited
+        self._joint_limits = JointLimitBounds(
+            joints.q_indices[limited],
+            joints.v_indices[limited],
+            joints.q_min[limited],
+            joints.q_max[limited],
+            config.joint_limit_horizon_s,
+        )
         self._kinematics = RobotKinematics(
             plant,
             robot,
@@ -343,22 +361,11 @@ class WholeBodyController(LeafSystem):
         # The weight's wrench about the CoM, [0; m g], N.
         self._W_gravity = np.zeros(6)
         self._W_gravity[3:] = self._kinematics.mass_kg * plant.gravity_field().gravity_vector()
-        # CoM gains (K_P, K_D) seated (True) and standing (False).
-        self._com_gains = {
-            seated: (np.array(kp), 2.0 * config.com_damping_ratio * np.sqrt(kp))
-            for seated, kp in (
-                (True, config.com_kp_seated_per_s2),
-                (False, config.com_kp_standing_per_s2),
-            )
-        }
         # Held rows of the seat's acceleration from seat_hinge_from_state: all but the
         # pitch about the hip axis (alpha_y in C).
         self._hinged_rows = np.ones(WRENCH_SIZE, dtype=bool)
         self._hinged_rows[1] = False
         self._hands = list(self.HANDS)
-        self._latched = np.ones(1)  # the posture state's latched flag
-        # The base's target orientation for the last (yaw, pitch), rad.
-        self._base_target = (None, None), None
         # One program per set of active contacts (seat and thighs, soles), built when
         # first needed.
         self._programs: dict[tuple[bool, bool], _Program] = {}
@@ -380,50 +387,6 @@ class WholeBodyController(LeafSystem):
         self.DeclareInitializationDiscreteUpdateEvent(self._Update)
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
 
-    def _posture_setup(self, config: ControllerConfig, joints: _Joints) -> None:
-        """Posture targets by state (actuator order, clamped inside the joint limits; NaN:
-        hold the state-1 posture) and the per-joint posture weights; the index arrays,
-        gains and limits the tick needs. Unknown joint names are an error."""
-        names = joints.names
-        named = {
-            "posture_state2_rad": config.posture_state2_rad,
-            "posture_state3_rad": config.posture_state3_rad,
-            "posture_state4_rad": config.posture_state4_rad,
-            "posture_weight_by_joint": config.posture_weight_by_joint,
-        }
-        for key, table in named.items():
-            unknown = sorted(set(table) - set(names))
-            if unknown:
-                raise ValueError(f"controller.{key}: unknown joint(s) {', '.join(unknown)}")
-        margin = config.posture_limit_margin_rad
-        self._q_target_min = joints.q_min + margin
-        self._q_target_max = joints.q_max - margin
-        tables = {1: np.full(len(names), np.nan)}
-        for state in (2, 3, 4):
-            table = named[f"posture_state{state}_rad"]
-            tables[state] = np.array([table.get(name, np.nan) for name in names])
-        # (clamped table, True where the joint holds the state-1 posture) by state.
-        self._posture_targets = {
-            state: (np.clip(table, self._q_target_min, self._q_target_max), np.isnan(table))
-            for state, table in tables.items()
-        }
-        self._posture_weights = np.array(
-            [config.posture_weight_by_joint.get(name, config.posture_weight) for name in names]
-        )
-        self._q_joints = as_slice(joints.q_indices)
-        self._v_joints = as_slice(joints.v_indices)
-        limited = joints.limited
-        self._limited_q = as_slice(joints.q_indices[limited])
-        self._limited_v = joints.v_indices[limited]
-        self._limited_rates = as_slice(self._limited_v)
-        self._limited_q_min = joints.q_min[limited]
-        self._limited_q_max = joints.q_max[limited]
-        self._kp_q = config.posture_kp_per_s2
-        self._kd_q = 2.0 * config.posture_damping_ratio * math.sqrt(self._kp_q)
-        self._kp_b = config.base_orientation_kp_per_s2
-        self._kd_b = 2.0 * config.base_orientation_damping_ratio * math.sqrt(self._kp_b)
-        self._blend = min(self._period_s / config.posture_filter_time_constant_s, 1.0)
-
     # --- Timing --------------------------------------------------------------------
 
     def timing_s(self) -> np.ndarray:
@@ -440,7 +403,6 @@ class WholeBodyController(LeafSystem):
 
     def CalcTick(self, context: Context) -> ControllerTick:
         """Solves the QP for the inputs and discrete state in context (no side effects)."""
-        config = self._config
         t_start = time.perf_counter()
         x = self._state_port.Eval(context)
         com_reference = self._reference_port.Eval(context)
@@ -455,57 +417,18 @@ class WholeBodyController(LeafSystem):
         terms = self._kinematics.calc(x, program.frames, self._hands if pulled else ())
         t_kinematics = time.perf_counter()
 
-        # Centroidal momentum: xddot*, the helpful part of the pull, Ldot*.
-        kp_com, kd_com = self._com_gains[standup_state <= 2]
-        xddot_star = com_acceleration_reference(
-            terms.p_WCom, terms.v_WCom, com_reference, kp_com, kd_com
-        )
         state = context.get_discrete_state()
-        Ldot_star = np.empty(6)
-        Ldot_star[:3] = -config.angular_momentum_kd_per_s * terms.L_WCom[:3]
-        Ldot_star[:3] -= config.angular_momentum_kp_per_s2 * state.get_value(
-            self._momentum_integral
+        references = self._references.calc(
+            terms,
+            standup_state,
+            com_reference,
+            F_hand_W if pulled else None,
+            state.get_value(self._momentum_integral),
+            state.get_value(self._posture),
         )
-        Ldot_star[3:] = terms.mass_kg * xddot_star
-        f_par = tau_hand = None
-        if pulled:
-            xd_dot = com_reference[3:6]
-            speed = math.sqrt(float(xd_dot @ xd_dot))
-            lead_m = (terms.p_WCom - com_reference[:3]) @ xd_dot / speed if speed > 0.0 else 0.0
-            f_par = helpful_force(
-                F_hand_W[3:6] + F_hand_W[9:12],
-                xd_dot,
-                lead_m,
-                config.help_fade_speed_mps,
-                config.help_max_lead_m,
-            )
-            Ldot_star[3:] += f_par
-            # J_h^T F_hand, both hands.
-            tau_hand = terms.J_W.reshape(12, self._nv).T @ F_hand_W
-        tasks = [
-            momentum_task(
-                program.qp.layout,
-                program.qp.contact_map(terms),
-                terms.p_BoCom,
-                Ldot_star,
-                None if tau_hand is None else tau_hand[:6],
-                self._W_gravity,
-                config.momentum_weight,
-            )
-        ]
-        posture, targets = self._posture_targets_of(
-            state.get_value(self._posture), terms, standup_state
-        )
-        commands = self._contact_commands(program, standup_state, plan)
-        vdot_min, vdot_max = joint_limit_acceleration_bounds(
-            terms.q[self._limited_q],
-            terms.v[self._limited_rates],
-            self._limited_q_min,
-            self._limited_q_max,
-            config.joint_limit_horizon_s,
-        )
+        commands = self._contact_commands(program, references.state.seat_hinged, plan)
         t_tasks = time.perf_counter()
-        solution = program.qp.solve(terms, tasks, targets, commands, tau_hand, vdot_min, vdot_max)
+        solution = program.qp.solve(terms, references, commands)
 
         normal_forces_N = np.zeros(len(self.CONTACTS))
         normal_forces_N[program.contact_index] = solution.F_C[:, NORMAL]
@@ -513,8 +436,8 @@ class WholeBodyController(LeafSystem):
             solution=solution,
             terms=terms,
             normal_forces_N=normal_forces_N,
-            helpful_force_W=np.zeros(3) if f_par is None else f_par,
-            posture=posture,
+            helpful_force_W=references.helpful_force_W,
+            posture=references.next_posture,
             inputs_s=t_inputs - t_start,
             kinematics_s=t_kinematics - t_inputs,
             assembly_s=t_tasks - t_kinematics + solution.assembly_s,
@@ -529,20 +452,35 @@ class WholeBodyController(LeafSystem):
             contacts = [
                 spec for spec in self.contact_specs if active[self.PLAN_SCALE[spec.frame] - 1]
             ]
-            layout = QpLayout.of(contacts, self._nv)
+            contact_map = ContactMap(contacts, self._nv)
+            layout = contact_map.layout
+            tasks = [
+                MomentumTask(layout, contact_map, self._W_gravity, config.momentum_weight),
+                CopCenteringTask(layout, contacts, config.cop_centering_weight),
+                PostureTask(
+                    layout,
+                    self._joints.q_indices,
+                    self._joints.v_indices,
+                    self._posture_weights,
+                    config.posture_kp_per_s2,
+                    config.posture_damping_ratio,
+                ),
+                BaseOrientationTask(
+                    layout,
+                    config.base_orientation_weight,
+                    config.base_orientation_kp_per_s2,
+                    config.base_orientation_damping_ratio,
+                ),
+            ]
             qp = WholeBodyQp(
-                contacts,
+                contact_map,
                 self._B,
                 torque_limit_Nm=config.torque_limit_Nm,
                 torque_weight=config.torque_weight,
                 wrench_weight=config.wrench_weight,
                 acceleration_weight=config.acceleration_weight,
-                fixed_tasks=[cop_centering_task(layout, contacts, config.cop_centering_weight)],
-                tracking_tasks=[
-                    posture_task(layout, self._joints.v_indices, self._posture_weights),
-                    base_orientation_task(layout, config.base_orientation_weight),
-                ],
-                bounded_accelerations=self._limited_v,
+                tasks=tasks,
+                acceleration_bounds=self._joint_limits,
                 solver=config.qp_solver,
             )
             soles = np.array([spec.frame in ("l_sole", "r_sole") for spec in contacts])
@@ -564,51 +502,13 @@ class WholeBodyController(LeafSystem):
             self._programs[active] = program
         return program
 
-    def _posture_targets_of(
-        self, posture: np.ndarray, terms: RobotTerms, standup_state: int
-    ) -> tuple[np.ndarray, list[np.ndarray]]:
-        """The posture state after this tick (posture: its value before); the targets of
-        the posture and base orientation tasks.
-
-        qddot* = -K_P (q - q_ref) - K_D qdot, q_ref low-pass filtered toward the state's
-        table (joints not in it: the posture latched at the first tick); the base is held
-        at the yaw of the first tick, pitched forward by the state's base pitch.
-        """
-        nu = self._nu
-        q_joints = terms.q[self._q_joints]
-        if posture[0] > 0.5:
-            q_initial, q_reference = posture[1 : 1 + nu], posture[1 + nu : 1 + 2 * nu]
-            base_yaw = posture[-1]
-        else:
-            q_initial, q_reference = q_joints, q_joints
-            base_yaw = math.atan2(terms.R_WB[1, 0], terms.R_WB[0, 0])
-        table, hold = self._posture_targets[standup_state]
-        q_next = np.where(
-            hold, np.minimum(np.maximum(q_initial, self._q_target_min), self._q_target_max), table
-        )
-        # The reference's next value: q_ref + blend (q_target - q_ref).
-        q_next -= q_reference
-        q_next *= self._blend
-        q_next += q_reference
-        next_posture = np.concatenate((self._latched, q_initial, q_next, (base_yaw,)))
-        qddot_star = posture_acceleration_reference(
-            q_joints, terms.v[self._v_joints], q_reference, self._kp_q, self._kd_q
-        )
-        # root_link's x axis points backwards: a forward pitch is about its -y.
-        key = (base_yaw, self._config.base_pitch_by_state_rad[standup_state - 1])
-        if key != self._base_target[0]:
-            self._base_target = key, yaw_pitch_rotation(key[0], -key[1])
-        wdot_star = base_orientation_reference(
-            terms.R_WB, terms.v[:3], self._base_target[1], self._kp_b, self._kd_b
-        )
-        return next_posture, [qddot_star, wdot_star]
-
     def _contact_commands(
-        self, program: "_Program", standup_state: int, plan: np.ndarray
+        self, program: "_Program", seat_hinged: bool, plan: np.ndarray
     ) -> ContactCommands:
         """Normal-force bounds from the plan: seat and thighs in seat_scale * [f_min,
         f_max_seat], soles in [feet_scale * f_min, f_max_foot]. The seat holds all six
-        rows until seat_hinge_from_state, then all but the pitch about the hip axis."""
+        rows until it is hinged (StateReferences.seat_hinged), then all but the pitch about
+        the hip axis."""
         config = self._config
         scales = plan[program.plan_index]
         max_normal_force_N = np.where(
@@ -617,7 +517,7 @@ class WholeBodyController(LeafSystem):
         return ContactCommands(
             scales * config.min_normal_force_N,
             max_normal_force_N,
-            program.partially_held[standup_state >= config.seat_hinge_from_state],
+            program.partially_held[seat_hinged],
         )
 
     def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:

@@ -15,7 +15,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import Scenario
-from drake_standup.control.tasks import helpful_force
+from drake_standup.control.references import helpful_force
 from drake_standup.control.terms import RobotKinematics
 from drake_standup.controller import ControllerConfig, WholeBodyController
 from drake_standup.scene import add_scene, set_seated_state

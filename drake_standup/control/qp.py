@@ -21,8 +21,9 @@ The program, built once and refilled every tick:
 
 The program holds only the contacts that are active: the controller keeps one per set
 of active contacts (its size, and so its solve time, shrinks once the seat is released).
-The tasks (A_k, b_k, w_k) come from control/tasks.py; the solver is a backend chosen by
-name (daqp, or Drake's OSQP / Clarabel).
+The tasks (A_k, b_k, w_k) are Task objects (control/tasks.py), consumed generically: the
+ones active in the tick's standup state, each refreshed by its update(); the solver is a
+backend chosen by name (daqp, or Drake's OSQP / Clarabel).
 
 The torque limits rarely bind (never in the default scenario's closed loop): each tick
 first solves without them, and again with them only if the torques come out beyond the
@@ -34,6 +35,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Protocol
 
 import daqp
 import numpy as np
@@ -45,6 +47,7 @@ from pydrake.solvers import (
 )
 
 from drake_standup.control.contacts import WRENCH_SIZE, ContactSpec, wrench_cone_matrix
+from drake_standup.control.references import STATES, TaskReferences
 from drake_standup.control.terms import RobotTerms
 
 N_BASE = 6  # unactuated floating-base velocities
@@ -73,16 +76,35 @@ class QpLayout:
         return self._wrench[c]
 
 
-@dataclass
 class Task:
-    """One least-squares objective, ||A z[columns] - b||^2 weighted by weight (a scalar,
-    or one weight per row of A)."""
+    """One least-squares objective, w ||A z[columns] - b||^2 (w: weight, a scalar or one
+    weight per row of A), in the standup states active_states (control/tasks.py).
+
+    A task sets weight, columns, A and b when it is made and refreshes what changes in
+    update(), each tick it is active. constant_A: A never changes, so the QP adds w A^T A
+    to its Hessian once per set of active tasks; constant_b: neither does b."""
 
     name: str
     weight: float | np.ndarray
-    A: np.ndarray  # (rows, width of columns)
-    b: np.ndarray | None  # (rows,); None for a tracking task (its b comes each tick)
     columns: slice
+    A: np.ndarray  # (rows, width of columns)
+    b: np.ndarray  # (rows,)
+    active_states: frozenset[int] = frozenset(STATES)
+    constant_A: bool = False
+    constant_b: bool = False
+
+    def update(self, terms: RobotTerms, references: TaskReferences) -> None:
+        """Refreshes A and/or b for the tick (a constant task has nothing to do)."""
+
+
+class AccelerationBounds(Protocol):
+    """Bounds vdot_min <= vdot[v_indices] <= vdot_max that change with the state
+    (control/tasks.py: JointLimitBounds)."""
+
+    v_indices: np.ndarray
+
+    def calc(self, terms: RobotTerms) -> tuple[np.ndarray, np.ndarray]:
+        """(vdot_min, vdot_max) at terms' state."""
 
 
 @dataclass
@@ -128,36 +150,78 @@ def as_slice(indices: np.ndarray) -> slice | np.ndarray:
     return indices
 
 
+class ContactMap:
+    """G^T (n_wrench, nv), G_c = J_c^T X_c: the contact unknowns to generalized forces
+    (X_c: the unknowns of contact c to its 6-D wrench at Co, in W): the rows of the
+    contacts' Jacobians expressed in their own frames (control/terms.py) that act on the
+    unknowns. Its first six columns map them to their resultant about the base origin, in
+    W. Shared by the QP and the tasks that need it, computed once per terms."""
+
+    def __init__(self, contacts: list[ContactSpec], nv: int):
+        self.contacts = list(contacts)
+        self.layout = QpLayout.of(contacts, nv)
+        # The unknowns' rows among each contact's 6-D wrench [tau; f] (f_z last): rows of
+        # the contacts' stacked Jacobians (nc * 6, nv).
+        self.unknowns = np.concatenate(
+            [
+                WRENCH_SIZE * c + np.arange(WRENCH_SIZE)[spec.components]
+                for c, spec in enumerate(contacts)
+            ]
+        )
+        self._GT: np.ndarray | None = None
+        self._terms: RobotTerms | None = None
+
+    def __call__(self, terms: RobotTerms) -> np.ndarray:
+        """G^T for terms, which holds the contact frames in this map's order."""
+        if self._terms is not terms:
+            self._GT = terms.J_F.reshape(-1, self.layout.nv)[self.unknowns]
+            self._terms = terms
+        return self._GT
+
+
+@dataclass
+class _ActiveTasks:
+    """The tasks active in a set of standup states and what the QP precomputes of them."""
+
+    updated: list[Task]  # the ones with an update() to call
+    varying: list[Task]  # A changes: w A^T A and w A^T b each tick
+    # A constant, b not: (task, -w A^T); their Hessian blocks are in H_fixed.
+    tracking: list[tuple[Task, np.ndarray]]
+    H_fixed: np.ndarray  # regularisation + w A^T A of the constant-A tasks
+    g_fixed: np.ndarray | None  # -w A^T b of the constant tasks (None: zero)
+
+
 class WholeBodyQp:
     """Builds the program of the module docstring once for a set of active contacts;
     refills and solves it each tick.
 
     Everything that does not depend on the state is filled in once: the cone rows, the
-    regularisation, the fixed tasks' cost and the tracking tasks' Hessian blocks.
+    regularisation, and for each set of active tasks the constant tasks' cost and the
+    Hessian blocks of those whose A is constant.
     """
 
     def __init__(
         self,
-        contacts: list[ContactSpec],
+        contact_map: ContactMap,
         B: np.ndarray,
         *,
         torque_limit_Nm: float,
         torque_weight: float,
         wrench_weight: float,
         acceleration_weight: float,
-        fixed_tasks: list[Task],
-        tracking_tasks: list[Task] = (),
-        bounded_accelerations: np.ndarray = (),
+        tasks: list[Task],
+        acceleration_bounds: AccelerationBounds | None = None,
         solver: str = "daqp",
     ):
-        """fixed_tasks: tasks whose A and b never change, added to the cost once.
-        tracking_tasks: tasks whose A never changes; solve() takes their b each tick.
-        bounded_accelerations: the entries of vdot that solve() bounds."""
+        """contact_map: the active contacts and their map (the tasks may share it).
+        tasks: the cost's tasks. acceleration_bounds: bounds on entries of vdot, computed
+        each tick (None: none)."""
         nv, nu = B.shape
         if not (np.all((B == 0) | (B == 1)) and np.all(B.sum(axis=0) == 1)):
             raise ValueError("the actuation matrix B must select one velocity per actuator")
-        self.layout = layout = QpLayout.of(contacts, nv)
-        self.contacts = list(contacts)
+        self.contact_map = contact_map
+        self.layout = layout = contact_map.layout
+        self.contacts = contacts = contact_map.contacts
         self.frames = [spec.frame for spec in contacts]
         self._solver = solver
         self._torque_limit_Nm = torque_limit_Nm
@@ -207,31 +271,26 @@ class WholeBodyQp:
         # lo, hi of the rows of (1) are r + these, r = tau_hand - h (rows in order).
         self._dynamics_lo = np.r_[np.zeros(N_BASE), np.full(nu, -torque_limit_Nm)]
         self._dynamics_hi = -self._dynamics_lo
-        # The unknowns' rows among each contact's 6-D wrench [tau; f] (f_z last): rows of
-        # the contacts' stacked Jacobians (nc * 6, nv); and the normal forces' entries of z.
-        self._unknowns = np.concatenate(
-            [
-                WRENCH_SIZE * c + np.arange(WRENCH_SIZE)[spec.components]
-                for c, spec in enumerate(contacts)
-            ]
-        )
+        # The normal forces' entries of z.
         self._normal = np.array([layout.wrench(c).stop - 1 for c in range(nc)])
-        self._bounded_vdot = nw + np.asarray(bounded_accelerations, dtype=int)
-        self._GT: np.ndarray | None = None
-        self._GT_terms: RobotTerms | None = None
+        self._acceleration_bounds = acceleration_bounds
+        if acceleration_bounds is not None:
+            self._bounded_vdot = nw + np.asarray(acceleration_bounds.v_indices, dtype=int)
 
-        self._H_fixed = np.diag(
+        self._H_regularisation = np.diag(
             np.concatenate([np.full(nw, wrench_weight), np.full(nv, acceleration_weight)])
         )
-        self._g_fixed = np.zeros(n)
-        self._add_tasks(self._H_fixed, self._g_fixed, fixed_tasks)
-        self._g_fixed_zero = not self._g_fixed.any()
-        # Tracking tasks: their Hessian blocks now; g[columns] += -(w A^T) b each tick.
-        self._tracking = []
-        for task in tracking_tasks:
-            WA = task.A.T * task.weight
-            self._H_fixed[task.columns, task.columns] += WA @ task.A
-            self._tracking.append((task.columns, -WA))
+        self.tasks = list(tasks)
+        # standup state -> its _ActiveTasks (states with the same active tasks share one).
+        by_flags: dict[tuple[bool, ...], _ActiveTasks] = {}
+        self._active_tasks: dict[int, _ActiveTasks] = {}
+        for state in STATES:
+            flags = tuple(state in task.active_states for task in self.tasks)
+            if flags not in by_flags:
+                by_flags[flags] = self._precompute(
+                    [task for task, on in zip(self.tasks, flags, strict=True) if on]
+                )
+            self._active_tasks[state] = by_flags[flags]
         # Without the torque rows (tried first), and with them (module docstring): A, lo,
         # hi, equality and a backend for each.
         self._programs = [
@@ -244,45 +303,47 @@ class WholeBodyQp:
         n = self.layout.n
         return slice(n + rows.start, n + rows.stop)
 
-    @staticmethod
-    def _add_tasks(H: np.ndarray, g: np.ndarray, tasks: list[Task]) -> None:
-        """H += sum A^T W A, g -= sum A^T W b, each on its task's block of columns."""
+    def _precompute(self, tasks: list[Task]) -> _ActiveTasks:
+        """For a set of active tasks: H_fixed = regularisation + w A^T A of those with a
+        constant A, g_fixed = -w A^T b of the constant ones, in the tasks' order."""
+        H = self._H_regularisation.copy()
+        g = np.zeros(self.layout.n)
+        tracking = []
         for task in tasks:
+            if not task.constant_A:
+                continue
             WA = task.A.T * task.weight
             H[task.columns, task.columns] += WA @ task.A
-            g[task.columns] -= WA @ task.b
-
-    def contact_map(self, terms: RobotTerms) -> np.ndarray:
-        """G^T (n_wrench, nv), G_c = J_c^T X_c: the contact unknowns to generalized forces
-        (X_c: the unknowns of contact c to its 6-D wrench at Co, in W): the rows of the
-        contacts' Jacobians expressed in their own frames (control/terms.py) that act on
-        the unknowns. Its first six columns map them to their resultant about the base
-        origin, in W. terms holds the program's contact frames, in its order. Computed
-        once per terms."""
-        if self._GT_terms is not terms:
-            self._GT = terms.J_F.reshape(-1, self.layout.nv)[self._unknowns]
-            self._GT_terms = terms
-        return self._GT
+            if task.constant_b:
+                g[task.columns] -= WA @ task.b
+            else:
+                tracking.append((task, -WA))
+        return _ActiveTasks(
+            updated=[task for task in tasks if not (task.constant_A and task.constant_b)],
+            varying=[task for task in tasks if not task.constant_A],
+            tracking=tracking,
+            H_fixed=H,
+            g_fixed=g if g.any() else None,
+        )
 
     def solve(
         self,
         terms: RobotTerms,
-        tasks: list[Task],
-        targets: list[np.ndarray],
+        references: TaskReferences,
         commands: ContactCommands,
-        tau_hand: np.ndarray | None,
-        vdot_min: np.ndarray,
-        vdot_max: np.ndarray,
     ) -> QpSolution:
         """Solves the tick's QP.
 
-        terms: for the program's contact frames (frame_names), in its order. tasks: this
-        tick's tasks (besides the fixed and tracking ones); targets: the tracking tasks' b,
-        in their order. tau_hand = J_h^T F_hand is the hands' generalized force (None: no
-        pull); vdot_min <= vdot <= vdot_max bound the bounded_accelerations (e.g. from
-        joint limits).
+        terms: for the program's contact frames (frames), in its order. references: what
+        the tasks track (and tau_hand = J_h^T F_hand, the hands' generalized force, None:
+        no pull); the tasks active in references.standup_state are updated from them.
+        commands: the contact plan's bounds and held rows.
         """
         t_start = time.perf_counter()
+        active = self._active_tasks[references.standup_state]
+        for task in active.updated:
+            task.update(terms, references)
+        tau_hand = references.tau_hand
         lo, hi = self._lo, self._hi
         GT = self.contact_map(terms)
 
@@ -314,22 +375,27 @@ class WholeBodyQp:
         # Normal forces (f_z comes last in F_c) and accelerations.
         lo[self._normal] = commands.min_normal_force_N
         hi[self._normal] = commands.max_normal_force_N
-        lo[self._bounded_vdot] = vdot_min
-        hi[self._bounded_vdot] = vdot_max
+        if self._acceleration_bounds is not None:
+            vdot_min, vdot_max = self._acceleration_bounds.calc(terms)
+            lo[self._bounded_vdot] = vdot_min
+            hi[self._bounded_vdot] = vdot_max
 
         # Cost: w_tau ||T z + t0||^2 with t0 = -r[actuated], the tasks, the fixed part.
         T = self._T
         r_actuated = r[self._actuated]
         WT = self._torque_weight * T.T
         H = WT @ T
-        H += self._H_fixed
+        H += active.H_fixed
         g = WT @ r_actuated
         np.negative(g, out=g)
-        if not self._g_fixed_zero:
-            g += self._g_fixed
-        self._add_tasks(H, g, tasks)
-        for (columns, minus_WA), b in zip(self._tracking, targets, strict=True):
-            g[columns] += minus_WA @ b
+        if active.g_fixed is not None:
+            g += active.g_fixed
+        for task in active.varying:
+            WA = task.A.T * task.weight
+            H[task.columns, task.columns] += WA @ task.A
+            g[task.columns] -= WA @ task.b
+        for task, minus_WA in active.tracking:
+            g[task.columns] += minus_WA @ task.b
         t_assembled = time.perf_counter()
 
         # Without the torque rows first (module docstring).
@@ -346,7 +412,7 @@ class WholeBodyQp:
         ok = ok and bool(np.isfinite(z).all())
         nc, nw = len(self.contacts), self.layout.n_wrench
         F_C = np.zeros((nc, WRENCH_SIZE))
-        F_C.reshape(-1)[self._unknowns] = z[:nw]
+        F_C.reshape(-1)[self.contact_map.unknowns] = z[:nw]
         return QpSolution(
             frames=list(self.frames),
             ok=ok,

@@ -1,23 +1,17 @@
-"""The controller's least-squares tasks and the references they track.
+"""The controller's least-squares tasks (control/qp.py: Task) and their feedback laws.
 
-Centroidal momentum (Nava et al., IROS 2016; SPEC 2), L = [L_ang about the CoM; m xdot]:
+Each task is w ||A z[columns] - b||^2 over the QP's unknowns z = [F_1 .. F_nc, vdot],
+refreshed by update(terms, references) from one tick's TaskReferences
+(control/references.py):
 
-    xddot* = xd_ddot - K_D (xdot - xd_dot) - K_P (x - x_d)
-    Ldot*  = [-K_D,ang L_ang - K_P,ang int L_ang;  m xddot* + f_par]
+    momentum          sum_c X_Com,c F_c = Ldot* - [0; m g] - W_hand,Com
+    posture           qddot = qddot* = -K_P (q - q_ref) - K_D qdot
+    base orientation  wdot_WB = wdot* = -K_P theta k - K_D w_WB
+    CoP centering     (CoP_c - c) f_z,c = 0 for each 6-D contact (constant)
 
-The contacts supply what gravity and the hands do not. The hands' measured wrench F_hand
-acts on the robot in full (it is in the dynamics rows of the QP, and in the momentum
-balance below), and the momentum target lets its helpful part f_par through, so the
-contacts cancel everything else of it:
-
-    sum_c X_Com,c F_c = Ldot* - [0; m g] - W_hand,Com
-
-f_par is the component of the total hand force f_h along the desired CoM velocity when it
-points along it (alpha > 0, SPEC 2), faded out as ||xd_dot|| -> 0 so that at the path's
-end the whole pull is compensated, and as the CoM runs ahead of its reference:
-
-    f_par = s(||xd_dot|| / v_fade) (1 - s(lead / lead_max)) max(0, f_h . u) u,
-    u = xd_dot / ||xd_dot||,  lead = (x - x_d) . u,  s = smoothstep (3 r^2 - 2 r^3 on [0, 1]).
+The hands' measured wrench F_hand acts on the robot in full (it is in the dynamics rows of
+the QP, and in the momentum balance above); Ldot* lets its helpful part f_par through, so
+the contacts cancel everything else of it.
 """
 
 import math
@@ -25,103 +19,102 @@ import math
 import numpy as np
 
 from drake_standup.control.contacts import ContactSpec
-from drake_standup.control.qp import QpLayout, Task
+from drake_standup.control.qp import ContactMap, QpLayout, Task, as_slice
+from drake_standup.control.references import TaskReferences
 from drake_standup.control.spatial import cross, rotation_vector, skew
+from drake_standup.control.terms import RobotTerms
 
 
-def com_acceleration_reference(
-    p_WCom: np.ndarray,
-    v_WCom: np.ndarray,
-    com_reference: np.ndarray,
-    kp_per_s2: np.ndarray,
-    kd_per_s: np.ndarray,
-) -> np.ndarray:
-    """xddot* = xd_ddot - K_D (xdot - xd_dot) - K_P (x - x_d), m/s^2.
+class MomentumTask(Task):
+    """sum_c X_Com,c F_c = Ldot* - [0; m g] - W_hand_Com (module docstring), with
+    X_Com,c = [R, (p_C - p_Com) x R; 0, R] (R = R_WC) mapping [tau_C; f_C] to the wrench
+    about the CoM in W (its force columns only for a point contact).
 
-    com_reference = [x_d, xd_dot, xd_ddot] (9,), world frame.
-    """
-    x_d, xd_dot, xd_ddot = com_reference[:3], com_reference[3:6], com_reference[6:9]
-    return xd_ddot - kd_per_s * (v_WCom - xd_dot) - kp_per_s2 * (p_WCom - x_d)
+    The first six columns of G^T (control/qp.py: ContactMap) map the contact unknowns to
+    their resultant wrench about the base origin Bo in W, and the first six entries of
+    J_h^T F_hand are the hands' resultant there (control/terms.py); about the CoM,
+    W_Com = [W_ang - p_BoCom x W_lin; W_lin]."""
 
+    name = "momentum"
 
-def _smoothstep(r: float) -> float:
-    r = min(max(r, 0.0), 1.0)
-    return r * r * (3.0 - 2.0 * r)
+    def __init__(
+        self,
+        layout: QpLayout,
+        contact_map: ContactMap,
+        W_gravity: np.ndarray,
+        weight: float,
+    ):
+        self.weight = weight
+        self.columns = layout.wrenches
+        self.A = np.empty((6, layout.n_wrench))
+        self.b = np.empty(6)
+        self._contact_map = contact_map
+        self._W_gravity = W_gravity  # [0; m g], N
 
-
-def helpful_force(
-    f_hand_W: np.ndarray,
-    xd_dot: np.ndarray,
-    lead_m: float,
-    fade_speed_mps: float,
-    max_lead_m: float,
-) -> np.ndarray:
-    """f_par, the part of the total hand force f_hand_W (N) the controller lets act.
-
-    lead_m = (x - x_d) . u is how far the CoM runs ahead of its reference along the path;
-    the help fades out (smoothstep) between a lead of 0 and max_lead_m, so that with psi
-    not advancing (or at its upper bound) a pull cannot carry the CoM past the reference.
-    """
-    speed = math.sqrt(float(xd_dot @ xd_dot))
-    if speed == 0.0:
-        return np.zeros(3)
-    u = xd_dot / speed
-    fade = _smoothstep(speed / fade_speed_mps) * (1.0 - _smoothstep(lead_m / max_lead_m))
-    return fade * max(float(f_hand_W @ u), 0.0) * u
+    def update(self, terms: RobotTerms, references: TaskReferences) -> None:
+        A, b = self.A, self.b
+        A[:] = self._contact_map(terms)[:, :6].T
+        A[:3] -= skew(terms.p_BoCom) @ A[3:]
+        np.subtract(references.Ldot_star, self._W_gravity, out=b)
+        if references.tau_hand is not None:
+            W_hand_Bo = references.tau_hand[:6]
+            b -= W_hand_Bo
+            b[:3] += cross(terms.p_BoCom, W_hand_Bo[3:])
 
 
-def momentum_task(
-    layout: QpLayout,
-    G_T: np.ndarray,
-    p_BoCom: np.ndarray,
-    Ldot_target: np.ndarray,
-    W_hand_Bo: np.ndarray | None,
-    W_gravity: np.ndarray,
-    weight: float,
-) -> Task:
-    """sum_c X_Com,c F_c = Ldot_target - [0; m g] - W_hand_Com (module docstring;
-    W_gravity = [0; m g]), with X_Com,c = [R, (p_C - p_Com) x R; 0, R] (R = R_WC) mapping
-    [tau_C; f_C] to the wrench about the CoM in W (its force columns only for a point
-    contact).
-
-    The first six columns of G^T (control/qp.py: WholeBodyQp.contact_map) map the contact
-    unknowns to their resultant wrench about the base origin Bo in W, and W_hand_Bo (the
-    first six entries of J_h^T F_hand; None: no pull) is the hands' resultant there
-    (control/terms.py); about the CoM, W_Com = [W_ang - p_BoCom x W_lin; W_lin].
-    """
-    A = G_T[:, :6].T.copy()
-    A[:3] -= skew(p_BoCom) @ A[3:]
-    b = Ldot_target - W_gravity
-    if W_hand_Bo is not None:
-        b -= W_hand_Bo
-        b[:3] += cross(p_BoCom, W_hand_Bo[3:])
-    return Task("momentum", weight, A, b, layout.wrenches)
-
-
-def cop_centering_task(layout: QpLayout, contacts: list[ContactSpec], weight: float) -> Task:
+class CopCenteringTask(Task):
     """Each 6-D contact's CoP at the centre c of its CoP box: [tau_x - c_y f_z;
     tau_y + c_x f_z] = 0, i.e. (CoP - c) f_z = 0. It settles how the load is shared, which
     the momentum task leaves free: away from the box edges, where a compliant pad starts
     to roll. Constant: the QP adds it once."""
-    wrenches = [c for c, spec in enumerate(contacts) if not spec.point]
-    A = np.zeros((2 * len(wrenches), layout.n_wrench))
-    for row, c in enumerate(wrenches):
-        wrench = layout.wrench(c)
-        c_x, c_y = np.mean(contacts[c].cop_x_m), np.mean(contacts[c].cop_y_m)
-        A[2 * row, wrench] = [1.0, 0.0, 0.0, 0.0, 0.0, -c_y]
-        A[2 * row + 1, wrench] = [0.0, 1.0, 0.0, 0.0, 0.0, c_x]
-    return Task("cop_centering", weight, A, np.zeros(len(A)), layout.wrenches)
+
+    name = "cop_centering"
+    constant_A = constant_b = True
+
+    def __init__(self, layout: QpLayout, contacts: list[ContactSpec], weight: float):
+        wrenches = [c for c, spec in enumerate(contacts) if not spec.point]
+        self.weight = weight
+        self.columns = layout.wrenches
+        self.A = np.zeros((2 * len(wrenches), layout.n_wrench))
+        for row, c in enumerate(wrenches):
+            wrench = layout.wrench(c)
+            c_x, c_y = np.mean(contacts[c].cop_x_m), np.mean(contacts[c].cop_y_m)
+            self.A[2 * row, wrench] = [1.0, 0.0, 0.0, 0.0, 0.0, -c_y]
+            self.A[2 * row + 1, wrench] = [0.0, 1.0, 0.0, 0.0, 0.0, c_x]
+        self.b = np.zeros(len(self.A))
 
 
-def posture_task(layout: QpLayout, v_indices: np.ndarray, weights: np.ndarray) -> Task:
-    """vdot[v_indices] = qddot*: joint accelerations in actuator order, row i weighted by
-    weights[i]; a tracking task (b = qddot*, see posture_acceleration_reference). The task
-    spans only the block of columns from the first to the last joint rate."""
-    first, last = int(v_indices.min()), int(v_indices.max())
-    A = np.zeros((len(v_indices), last - first + 1))
-    A[np.arange(len(v_indices)), v_indices - first] = 1.0
-    columns = slice(layout.vdot.start + first, layout.vdot.start + last + 1)
-    return Task("posture", np.asarray(weights, dtype=float), A, None, columns)
+class PostureTask(Task):
+    """vdot[v_indices] = qddot* = -K_P (q - q_ref) - K_D qdot: joint accelerations in
+    actuator order, row i weighted by weights[i], q_ref from TaskReferences. A spans only
+    the block of columns from the first to the last joint rate."""
+
+    name = "posture"
+    constant_A = True
+
+    def __init__(
+        self,
+        layout: QpLayout,
+        q_indices: np.ndarray,
+        v_indices: np.ndarray,
+        weights: np.ndarray,
+        kp_per_s2: float,
+        damping_ratio: float,
+    ):
+        first, last = int(v_indices.min()), int(v_indices.max())
+        self.weight = np.asarray(weights, dtype=float)
+        self.columns = slice(layout.vdot.start + first, layout.vdot.start + last + 1)
+        self.A = np.zeros((len(v_indices), last - first + 1))
+        self.A[np.arange(len(v_indices)), v_indices - first] = 1.0
+        self.b = np.zeros(len(v_indices))
+        self._q, self._v = as_slice(q_indices), as_slice(v_indices)
+        self._kp = kp_per_s2
+        self._kd = 2.0 * damping_ratio * math.sqrt(kp_per_s2)
+
+    def update(self, terms: RobotTerms, references: TaskReferences) -> None:
+        self.b = posture_acceleration_reference(
+            terms.q[self._q], terms.v[self._v], references.q_reference, self._kp, self._kd
+        )
 
 
 def posture_acceleration_reference(
@@ -131,12 +124,25 @@ def posture_acceleration_reference(
     return -kp_per_s2 * (q - q_reference) - kd_per_s * qdot
 
 
-def base_orientation_task(layout: QpLayout, weight: float) -> Task:
-    """wdot_WB = wdot*: the base's angular acceleration, a tracking task (b = wdot*, see
-    base_orientation_reference). The base comes first in v: vdot[:3] = wdot_WB
-    (control/terms.py)."""
-    base = slice(layout.vdot.start, layout.vdot.start + 3)
-    return Task("base_orientation", weight, np.eye(3), None, base)
+class BaseOrientationTask(Task):
+    """wdot_WB = wdot* (base_orientation_reference) toward TaskReferences.R_WB_target. The
+    base comes first in v: vdot[:3] = wdot_WB (control/terms.py)."""
+
+    name = "base_orientation"
+    constant_A = True
+
+    def __init__(self, layout: QpLayout, weight: float, kp_per_s2: float, damping_ratio: float):
+        self.weight = weight
+        self.columns = slice(layout.vdot.start, layout.vdot.start + 3)
+        self.A = np.eye(3)
+        self.b = np.zeros(3)
+        self._kp = kp_per_s2
+        self._kd = 2.0 * damping_ratio * math.sqrt(kp_per_s2)
+
+    def update(self, terms: RobotTerms, references: TaskReferences) -> None:
+        self.b = base_orientation_reference(
+            terms.R_WB, terms.v[:3], references.R_WB_target, self._kp, self._kd
+        )
 
 
 def base_orientation_reference(
@@ -152,6 +158,30 @@ def base_orientation_reference(
     wdot *= -kp_per_s2
     wdot -= kd_per_s * w_WB
     return wdot
+
+
+class JointLimitBounds:
+    """vdot_min <= vdot[v_indices] <= vdot_max (joint_limit_acceleration_bounds) for the
+    given joints, from their limits q_min, q_max and the horizon T (horizon_s)."""
+
+    def __init__(
+        self,
+        q_indices: np.ndarray,
+        v_indices: np.ndarray,
+        q_min: np.ndarray,
+        q_max: np.ndarray,
+        horizon_s: float,
+    ):
+        self.v_indices = v_indices
+        self._q, self._v = as_slice(q_indices), as_slice(v_indices)
+        self._q_min, self._q_max = q_min, q_max
+        self._horizon_s = horizon_s
+
+    def calc(self, terms: RobotTerms) -> tuple[np.ndarray, np.ndarray]:
+        """(vdot_min, vdot_max) at terms' state."""
+        return joint_limit_acceleration_bounds(
+            terms.q[self._q], terms.v[self._v], self._q_min, self._q_max, self._horizon_s
+        )
 
 
 def joint_limit_acceleration_bounds(

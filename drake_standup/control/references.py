@@ -1,0 +1,261 @@
+"""What the tasks track: the per-state schedule and each tick's references (SPEC 3, 7).
+
+StandupSchedule is the one place for what changes with the standup state (defaults of
+ControllerConfig):
+
+    state   CoM K_P            posture target               base pitch   seat
+    1       com_kp_seated      the first tick's posture     0.0 rad      held
+    2       com_kp_seated      posture_state2_rad           0.4 rad      hinged
+    3       com_kp_standing    posture_state3_rad           0.3 rad      hinged
+    4       com_kp_standing    posture_state4_rad           0.0 rad      hinged
+
+with K_D = 2 zeta sqrt(K_P); joints a table does not name hold the first tick's posture;
+targets lie posture_limit_margin_rad inside the joint limits; the seat lets the pelvis
+pitch about the hip axis from seat_hinge_from_state on.
+
+ReferenceGenerator turns the schedule, the CoM reference and the measured pull into one
+tick's TaskReferences. Centroidal momentum (Nava et al., IROS 2016; SPEC 2),
+L = [L_ang about the CoM; m xdot]:
+
+    xddot* = xd_ddot - K_D (xdot - xd_dot) - K_P (x - x_d)
+    Ldot*  = [-K_D,ang L_ang - K_P,ang int L_ang;  m xddot* + f_par]
+
+The hands' measured wrench acts on the robot in full (control/tasks.py: MomentumTask);
+the momentum target lets its helpful part f_par through: the component of the total hand
+force f_h along the desired CoM velocity when it points along it (alpha > 0, SPEC 2),
+faded out as ||xd_dot|| -> 0 so that at the path's end the whole pull is compensated, and
+as the CoM runs ahead of its reference:
+
+    f_par = s(||xd_dot|| / v_fade) (1 - s(lead / lead_max)) max(0, f_h . u) u,
+    u = xd_dot / ||xd_dot||,  lead = (x - x_d) . u,  s = smoothstep (3 r^2 - 2 r^3 on [0, 1]).
+
+The posture reference and the base's target orientation:
+
+    q_ref  <- q_ref + (T / tau_f) (q_target - q_ref)      first-order filter, period T
+    R_WB*  = R(yaw_0, pitch): the first tick's yaw, the state's forward pitch
+"""
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from drake_standup.control.spatial import yaw_pitch_rotation
+from drake_standup.control.terms import RobotTerms
+
+if TYPE_CHECKING:
+    from drake_standup.controller import ControllerConfig
+
+STATES = (1, 2, 3, 4)
+
+
+def com_acceleration_reference(
+    p_WCom: np.ndarray,
+    v_WCom: np.ndarray,
+    com_reference: np.ndarray,
+    kp_per_s2: np.ndarray,
+    kd_per_s: np.ndarray,
+) -> np.ndarray:
+    """xddot* = xd_ddot - K_D (xdot - xd_dot) - K_P (x - x_d), m/s^2.
+
+    com_reference = [x_d, xd_dot, xd_ddot] (9,), world frame.
+    """
+    x_d, xd_dot, xd_ddot = com_reference[:3], com_reference[3:6], com_reference[6:9]
+    return xd_ddot - kd_per_s * (v_WCom - xd_dot) - kp_per_s2 * (p_WCom - x_d)
+
+
+def _smoothstep(r: float) -> float:
+    r = min(max(r, 0.0), 1.0)
+    return r * r * (3.0 - 2.0 * r)
+
+
+def helpful_force(
+    f_hand_W: np.ndarray,
+    xd_dot: np.ndarray,
+    lead_m: float,
+    fade_speed_mps: float,
+    max_lead_m: float,
+) -> np.ndarray:
+    """f_par, the part of the total hand force f_hand_W (N) the controller lets act.
+
+    lead_m = (x - x_d) . u is how far the CoM runs ahead of its reference along the path;
+    the help fades out (smoothstep) between a lead of 0 and max_lead_m, so that with psi
+    not advancing (or at its upper bound) a pull cannot carry the CoM past the reference.
+    """
+    speed = math.sqrt(float(xd_dot @ xd_dot))
+    if speed == 0.0:
+        return np.zeros(3)
+    u = xd_dot / speed
+    fade = _smoothstep(speed / fade_speed_mps) * (1.0 - _smoothstep(lead_m / max_lead_m))
+    return fade * max(float(f_hand_W @ u), 0.0) * u
+
+
+def joint_values(
+    names: list[str], table: dict[str, float], key: str, default: float = math.nan
+) -> np.ndarray:
+    """table (joint name -> value) in the order of names, default where a joint is not
+    named; an unknown name is an error that names the config field key."""
+    unknown = sorted(set(table) - set(names))
+    if unknown:
+        raise ValueError(f"controller.{key}: unknown joint(s) {', '.join(unknown)}")
+    return np.array([table.get(name, default) for name in names])
+
+
+@dataclass(frozen=True)
+class StateReferences:
+    """What one standup state asks of the tasks and the seat."""
+
+    com_kp_per_s2: np.ndarray  # K_P (x, y, z), 1/s^2
+    com_kd_per_s: np.ndarray  # K_D = 2 zeta sqrt(K_P), 1/s
+    # Posture target, actuator order, clamped inside the joint limits; NaN where hold.
+    posture_rad: np.ndarray
+    posture_hold: np.ndarray  # True: the joint holds the first tick's posture
+    base_pitch_rad: float  # forward pitch of the base target
+    seat_hinged: bool  # the seat leaves the pelvis' pitch about the hip axis free
+
+
+class StandupSchedule:
+    """StateReferences of states 1-4 from a ControllerConfig (module docstring)."""
+
+    def __init__(
+        self,
+        config: "ControllerConfig",
+        joint_names: list[str],
+        q_min: np.ndarray,
+        q_max: np.ndarray,
+    ):
+        margin = config.posture_limit_margin_rad
+        self.q_target_min = q_min + margin
+        self.q_target_max = q_max - margin
+        tables = {1: np.full(len(joint_names), np.nan)}
+        for state in STATES[1:]:
+            key = f"posture_state{state}_rad"
+            tables[state] = joint_values(joint_names, getattr(config, key), key)
+        com_gains = {
+            seated: (np.array(kp), 2.0 * config.com_damping_ratio * np.sqrt(kp))
+            for seated, kp in (
+                (True, config.com_kp_seated_per_s2),
+                (False, config.com_kp_standing_per_s2),
+            )
+        }
+        self._by_state = {
+            state: StateReferences(
+                *com_gains[state <= 2],
+                np.clip(tables[state], self.q_target_min, self.q_target_max),
+                np.isnan(tables[state]),
+                config.base_pitch_by_state_rad[state - 1],
+                state >= config.seat_hinge_from_state,
+            )
+            for state in STATES
+        }
+
+    def __getitem__(self, standup_state: int) -> StateReferences:
+        return self._by_state[standup_state]
+
+
+@dataclass(slots=True)
+class TaskReferences:
+    """One tick's references, computed upstream of the QP: what Task.update reads."""
+
+    standup_state: int
+    state: StateReferences
+    Ldot_star: np.ndarray  # (6,) [Ldot_ang*; m xddot* + f_par], N m / N
+    tau_hand: np.ndarray | None  # J_h^T F_hand, both hands (None: no pull)
+    q_reference: np.ndarray  # (nu,) filtered posture reference, rad
+    R_WB_target: np.ndarray  # (3, 3) base target orientation
+    helpful_force_W: np.ndarray  # f_par, N (zero: no pull)
+    # The posture state after this tick: [latched flag, first tick's posture (nu),
+    # q_ref's next value (nu), first tick's base yaw].
+    next_posture: np.ndarray
+
+
+class ReferenceGenerator:
+    """The module docstring's references for each tick, from the schedule and the
+    controller's state (momentum integral, posture state)."""
+
+    def __init__(
+        self,
+        config: "ControllerConfig",
+        schedule: StandupSchedule,
+        q_joints: slice | np.ndarray,
+        period_s: float,
+    ):
+        """q_joints: the actuated joints' entries of q, in the schedule's order."""
+        self._config = config
+        self.schedule = schedule
+        self._q_joints = q_joints
+        self._nu = len(schedule.q_target_min)
+        self._blend = min(period_s / config.posture_filter_time_constant_s, 1.0)
+        self._latched = np.ones(1)  # the posture state's latched flag
+        # The base's target orientation for the last (yaw, pitch), rad.
+        self._base_target = (None, None), None
+
+    def calc(
+        self,
+        terms: RobotTerms,
+        standup_state: int,
+        com_reference: np.ndarray,
+        F_hand_W: np.ndarray | None,
+        momentum_integral: np.ndarray,
+        posture: np.ndarray,
+    ) -> TaskReferences:
+        """com_reference = [x_d, xd_dot, xd_ddot] (9,); F_hand_W = [tau_l, f_l, tau_r, f_r]
+        (None: no pull); momentum_integral = int L_ang dt; posture: the posture state
+        before this tick (TaskReferences.next_posture)."""
+        config = self._config
+        state = self.schedule[standup_state]
+        xddot_star = com_acceleration_reference(
+            terms.p_WCom, terms.v_WCom, com_reference, state.com_kp_per_s2, state.com_kd_per_s
+        )
+        Ldot_star = np.empty(6)
+        Ldot_star[:3] = -config.angular_momentum_kd_per_s * terms.L_WCom[:3]
+        Ldot_star[:3] -= config.angular_momentum_kp_per_s2 * momentum_integral
+        Ldot_star[3:] = terms.mass_kg * xddot_star
+        tau_hand = None
+        f_par = np.zeros(3)
+        if F_hand_W is not None:
+            xd_dot = com_reference[3:6]
+            speed = math.sqrt(float(xd_dot @ xd_dot))
+            lead_m = (terms.p_WCom - com_reference[:3]) @ xd_dot / speed if speed > 0.0 else 0.0
+            f_par = helpful_force(
+                F_hand_W[3:6] + F_hand_W[9:12],
+                xd_dot,
+                lead_m,
+                config.help_fade_speed_mps,
+                config.help_max_lead_m,
+            )
+            Ldot_star[3:] += f_par
+            tau_hand = terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
+
+        nu = self._nu
+        if posture[0] > 0.5:
+            q_initial, q_reference = posture[1 : 1 + nu], posture[1 + nu : 1 + 2 * nu]
+            base_yaw = posture[-1]
+        else:
+            q_initial = q_reference = terms.q[self._q_joints]
+            base_yaw = math.atan2(terms.R_WB[1, 0], terms.R_WB[0, 0])
+        schedule = self.schedule
+        q_next = np.where(
+            state.posture_hold,
+            np.minimum(np.maximum(q_initial, schedule.q_target_min), schedule.q_target_max),
+            state.posture_rad,
+        )
+        # The reference's next value: q_ref + blend (q_target - q_ref).
+        q_next -= q_reference
+        q_next *= self._blend
+        q_next += q_reference
+        # root_link's x axis points backwards: a forward pitch is about its -y.
+        key = (base_yaw, state.base_pitch_rad)
+        if key != self._base_target[0]:
+            self._base_target = key, yaw_pitch_rotation(key[0], -key[1])
+        return TaskReferences(
+            standup_state=standup_state,
+            state=state,
+            Ldot_star=Ldot_star,
+            tau_hand=tau_hand,
+            q_reference=q_reference,
+            R_WB_target=self._base_target[1],
+            helpful_force_W=f_par,
+            next_posture=np.concatenate((self._latched, q_initial, q_next, (base_yaw,))),
+        )
