@@ -908,7 +908,8 @@ def main(argv: list[str] | None = None) -> int:
         nargs="+",
         type=float,
         default=list(STEPS_MS),
-        help="plant steps; the smallest is the reference (default: %(default)s)",
+        help="plant steps, ms; 1 ms is the reference, a smaller one checks it "
+        "(default: %(default)s)",
     )
     parser.add_argument("--fresh", action="store_true", help="simulate every run again")
     parser.add_argument(
