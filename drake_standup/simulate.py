@@ -8,6 +8,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import os
 import shutil
 import subprocess
 import sys
@@ -123,8 +124,16 @@ class _Baseline:
         command = [sys.executable, "-m", "drake_standup.simulate", "--baseline-dir"]
         command += [str(self._dir), "--controller", controller, "--chunk", repr(chunk_s)]
         self._stderr = open(self._dir / "stderr.txt", "w")  # noqa: SIM115 - closed in result()
+        # The child imports this very package, installed or not.
+        env = dict(os.environ)
+        package_root = str(Path(__file__).resolve().parent.parent)
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [package_root, env.get("PYTHONPATH")]))
         self._process = subprocess.Popen(
-            command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self._stderr
+            command,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=self._stderr,
+            env=env,
         )
 
     def result(self) -> RunResult:
