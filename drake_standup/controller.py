@@ -54,7 +54,7 @@ from drake_standup.control.tasks import (
     PostureTask,
 )
 from drake_standup.control.terms import BASE_BODY, RobotKinematics, RobotTerms
-from drake_standup.robot import Robot
+from drake_standup.robot import Robot, actuated_joints
 
 _POSTURE_JOINTS = (
     "hip_pitch",
@@ -251,18 +251,14 @@ class _Joints:
 def _actuated_joints(plant: MultibodyPlant, robot: Robot, held_frames: list[str]) -> _Joints:
     held_bodies = {robot.frame(plant, name).body().index() for name in held_frames}
     held_bodies.discard(plant.GetBodyByName(BASE_BODY, robot.model_instance).index())
-    actuators = sorted(
-        (
-            plant.get_joint_actuator(index)
-            for index in plant.GetJointActuatorIndices(robot.model_instance)
-        ),
-        key=lambda actuator: actuator.input_start(),
-    )
-    joints = [actuator.joint() for actuator in actuators]
+    # Indices into the robot's state: the chair and floor are welded, so the
+    # robot's q and v are the plant's.
+    actuated = actuated_joints(plant, robot.model_instance)
+    joints = [plant.GetJointByName(name, robot.model_instance) for name in actuated.names]
     return _Joints(
-        names=[joint.name() for joint in joints],
-        q_indices=np.array([joint.position_start() for joint in joints]),
-        v_indices=np.array([joint.velocity_start() for joint in joints]),
+        names=actuated.names,
+        q_indices=actuated.q_index,
+        v_indices=actuated.v_index,
         q_min=np.array([joint.position_lower_limits()[0] for joint in joints]),
         q_max=np.array([joint.position_upper_limits()[0] for joint in joints]),
         limited=np.array(

@@ -18,6 +18,7 @@ from drake_standup.controller import WholeBodyController
 from drake_standup.human import HumanWrenchSource
 from drake_standup.perturbations import NoisyWrenchSensor, PushSource
 from drake_standup.reference import CoMReferenceGenerator
+from drake_standup.robot import ActuatedJoints, actuated_joints
 from drake_standup.scene import Scene, add_scene, set_seated_state
 from drake_standup.sensing import RobotSensing, heel_points
 from drake_standup.state_machine import StandupStateMachine
@@ -253,32 +254,6 @@ def add_seat_hold(builder: DiagramBuilder, scene: Scene, scenario: Scenario) -> 
     feedforward = builder.AddNamedSystem("seat_hold_feedforward", ConstantVectorSource(u_ff))
     builder.Connect(setpoint.get_output_port(), plant.get_desired_state_input_port(instance))
     builder.Connect(feedforward.get_output_port(), plant.get_actuation_input_port(instance))
-
-
-@dataclass
-class ActuatedJoints:
-    """The instance's actuated joints in actuation order (the order of the
-    actuation input and net_actuation output), and where each joint's position
-    and velocity sit in the instance's state [q; v]."""
-
-    names: list[str]
-    q_index: np.ndarray  # (n_u,) into the instance's q
-    v_index: np.ndarray  # (n_u,) into the instance's v
-
-
-def actuated_joints(plant, instance) -> ActuatedJoints:
-    joints = [plant.get_joint(j) for j in plant.GetJointIndices(instance)]
-    first_q = min(j.position_start() for j in joints if j.num_positions() > 0)
-    first_v = min(j.velocity_start() for j in joints if j.num_velocities() > 0)
-    actuators = sorted(
-        (plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(instance)),
-        key=lambda a: a.input_start(),
-    )
-    return ActuatedJoints(
-        names=[a.joint().name() for a in actuators],
-        q_index=np.array([a.joint().position_start() - first_q for a in actuators]),
-        v_index=np.array([a.joint().velocity_start() - first_v for a in actuators]),
-    )
 
 
 def _actuated_position_selector(plant, instance) -> np.ndarray:

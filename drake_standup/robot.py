@@ -415,3 +415,30 @@ def actuated_vector(plant: MultibodyPlant, instance, values: dict[str, float]) -
         actuator: JointActuator = plant.get_joint_actuator(index)
         out[actuator.input_start()] = values.get(actuator.joint().name(), 0.0)
     return out
+
+
+@dataclass
+class ActuatedJoints:
+    """The instance's actuated joints in actuation order (the order of the
+    actuation input and net_actuation output), and where each joint's position
+    and velocity sit in the instance's state [q; v]."""
+
+    names: list[str]
+    q_index: np.ndarray  # (n_u,) into the instance's q
+    v_index: np.ndarray  # (n_u,) into the instance's v
+
+
+def actuated_joints(plant: MultibodyPlant, instance: ModelInstanceIndex) -> ActuatedJoints:
+    """The instance's actuated joints (add_icub: one actuator per revolute joint)."""
+    joints = [plant.get_joint(j) for j in plant.GetJointIndices(instance)]
+    first_q = min(j.position_start() for j in joints if j.num_positions() > 0)
+    first_v = min(j.velocity_start() for j in joints if j.num_velocities() > 0)
+    actuators = sorted(
+        (plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(instance)),
+        key=lambda a: a.input_start(),
+    )
+    return ActuatedJoints(
+        names=[a.joint().name() for a in actuators],
+        q_index=np.array([a.joint().position_start() - first_q for a in actuators]),
+        v_index=np.array([a.joint().velocity_start() - first_v for a in actuators]),
+    )
