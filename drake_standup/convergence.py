@@ -771,7 +771,7 @@ def run_study(
     progress: bool = True,
 ) -> StudyResult:
     """Simulates what OUT/runs/ does not hold yet, compares, chooses, reports."""
-    from drake_standup.outputs import json_safe
+    from drake_standup.sweep import run_on_cluster, write_json
 
     out_dir = Path(out_dir)
     runs_dir = out_dir / "runs"
@@ -792,13 +792,11 @@ def run_study(
     def on_result(case: Case, metrics: dict | None, lost: BaseException | None) -> dict:
         if lost is not None:
             metrics = {"success": False, "failure_reason": f"cluster: {lost!r}"[:300]}
-            _write_json(runs_dir / case.name / "metrics.json", metrics)
+            write_json(runs_dir / case.name / "metrics.json", metrics)
         return metrics
 
     t0 = time.perf_counter()
     if todo:
-        from drake_standup.sweep import run_on_cluster
-
         tasks = [
             (
                 c,
@@ -854,7 +852,7 @@ def run_study(
         "runs": records,
     }
     files = [out_dir / "convergence.json", out_dir / "convergence.md", out_dir / "convergence.png"]
-    _write_json(files[0], json_safe(_inf_as_text(study)))
+    write_json(files[0], _inf_as_text(study))
     files[1].write_text(markdown(records, choice, wall_s if todo else None))
     draw_figure(records, files[2])
     return StudyResult(records, choice, len(todo), len(cases) - len(todo), wall_s, files)
@@ -870,13 +868,6 @@ def _inf_as_text(x):
     if isinstance(x, float) and math.isinf(x):
         return "inf" if x > 0 else "-inf"
     return x
-
-
-def _write_json(path: Path, data) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=1) + "\n")
-    tmp.replace(path)
 
 
 # --- Command line -------------------------------------------------------------

@@ -536,7 +536,7 @@ def run_sweep(
     out_dir = Path(out_dir)
     runs_dir = out_dir / "runs"
     runs_dir.mkdir(parents=True, exist_ok=True)
-    _write_json(
+    write_json(
         out_dir / "sweep.json",
         {
             "name": spec.name,
@@ -571,7 +571,7 @@ def run_sweep(
             "metrics": metrics,
             "retry": lost is not None,
         }
-        _write_json(runs_dir / f"{run.run_id}.json", record)
+        write_json(runs_dir / f"{run.run_id}.json", record)
         records[run.run_id] = record
         return metrics
 
@@ -594,9 +594,12 @@ def run_sweep(
     return SweepResult(runs, records, table, [f for f in figures if f], len(todo), wall_s)
 
 
-def _write_json(path: Path, data) -> None:
+def write_json(path: Path, data) -> None:
+    """data as JSON (json_safe), written whole or not at all (a temporary file
+    renamed over path), its folder made if needed."""
     from drake_standup.outputs import json_safe
 
+    path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
     tmp.write_text(json.dumps(json_safe(data), indent=1) + "\n")
     tmp.replace(path)
