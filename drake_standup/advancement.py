@@ -75,11 +75,17 @@ def psi_dot_law(
 class TrajectoryAdvancement(LeafSystem):
     """Inputs com_W, com_velocity_W, omega_f_W, x_d_W, path_tangent_W (3 each).
 
-    Continuous state [psi, psi_dot_f]: psi integrates the law; psi_dot_f is
-    psi_dot low-passed (time constant psi_ddot_filter_s), whose derivative is
-    the psi_ddot the reference's feed-forward acceleration needs (the law
-    itself is not differentiable where it saturates or the gate switches).
-    Outputs psi, psi_dot, psi_ddot, alpha (1 each).
+    Continuous state [psi, psi_dot]: the law sets the rate psi_dot tends to,
+    with time constant psi_ddot_filter_s, and psi integrates psi_dot. The
+    law jumps where it saturates or its gates switch (1 -> 2.5 and back);
+    a reference that followed it would jump in velocity, and its end-of-path
+    deceleration at psi_dot 2.5 -> 1 lifted the erect robot off its feet
+    (measured). So xd_dot is continuous and psi_ddot, which the reference's
+    feed-forward acceleration needs, is the exact derivative of the rate it
+    uses. psi_dot stays within [1, psi_dot_upper] (a first-order lag of a
+    signal in that range), and psi = t exactly while the law says 1.
+    Outputs psi, psi_dot, psi_ddot, alpha (1 each), and psi_dot_law (the
+    law's value, the target of psi_dot).
     """
 
     def __init__(self, config: AdvancementConfig):
@@ -104,12 +110,13 @@ class TrajectoryAdvancement(LeafSystem):
         }
         self._law_cache = declare_cached(self, "psi_dot law", self._calc_law, inputs)
         law = {self._law_cache.ticket()}
-        self.DeclareVectorOutputPort("psi_dot", 1, self._CalcPsiDot, prerequisites_of_calc=law)
+        state = {self.all_state_ticket()}
+        self.DeclareVectorOutputPort("psi_dot", 1, self._CalcPsiDot, prerequisites_of_calc=state)
         self.DeclareVectorOutputPort(
-            "psi_ddot",
-            1,
-            self._CalcPsiDdot,
-            prerequisites_of_calc=law | {self.all_state_ticket()},
+            "psi_ddot", 1, self._CalcPsiDdot, prerequisites_of_calc=law | state
+        )
+        self.DeclareVectorOutputPort(
+            "psi_dot_law", 1, self._CalcPsiDotLaw, prerequisites_of_calc=law
         )
         self.DeclareVectorOutputPort("alpha", 1, self._CalcAlpha, prerequisites_of_calc=law)
 
@@ -127,22 +134,26 @@ class TrajectoryAdvancement(LeafSystem):
             lambda: lead(self._com.Eval(context), self._x_d.Eval(context), tangent),
         )
 
-    def _psi_ddot(self, context: Context, psi_dot: float) -> float:
-        psi_dot_f = context.get_continuous_state_vector().GetAtIndex(1)
-        return (psi_dot - psi_dot_f) / self._config.psi_ddot_filter_s
+    def _psi_ddot(self, context: Context) -> float:
+        """psi_ddot = (law - psi_dot) / psi_ddot_filter_s; exactly 0 while both are 1."""
+        psi_dot = context.get_continuous_state_vector().GetAtIndex(1)
+        return (self._law(context)[0] - psi_dot) / self._config.psi_ddot_filter_s
 
     def DoCalcTimeDerivatives(self, context: Context, derivatives: ContinuousState) -> None:
-        psi_dot, _ = self._law(context)
-        derivatives.get_mutable_vector().SetFromVector([psi_dot, self._psi_ddot(context, psi_dot)])
+        psi_dot = context.get_continuous_state_vector().GetAtIndex(1)
+        derivatives.get_mutable_vector().SetFromVector([psi_dot, self._psi_ddot(context)])
 
     def _CalcPsi(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, context.get_continuous_state_vector().GetAtIndex(0))
 
     def _CalcPsiDot(self, context: Context, output: BasicVector) -> None:
-        output.SetAtIndex(0, self._law(context)[0])
+        output.SetAtIndex(0, context.get_continuous_state_vector().GetAtIndex(1))
 
     def _CalcPsiDdot(self, context: Context, output: BasicVector) -> None:
-        output.SetAtIndex(0, self._psi_ddot(context, self._law(context)[0]))
+        output.SetAtIndex(0, self._psi_ddot(context))
+
+    def _CalcPsiDotLaw(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self._law(context)[0])
 
     def _CalcAlpha(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, self._law(context)[1])

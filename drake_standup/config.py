@@ -151,7 +151,9 @@ class AdvancementConfig:
     # tolerance admits the tracker's steady lag. m.
     lead_gate: bool = True
     lag_tolerance_m: float = 0.005
-    # Time constant of the psi_dot filter whose derivative feeds xd_ddot. s.
+    # psi_dot tends to the law's value with this time constant (psi integrates
+    # it): the law jumps (1 -> 2.5 at a gate); a reference following it jumped
+    # in velocity and lifted the erect robot off its feet (measured). s.
     psi_ddot_filter_s: float = 0.05
 
 
@@ -174,10 +176,13 @@ class StandupConfig:
     state2_com_delta_m: list[float] = field(default_factory=lambda: [0.1277, 0.0, 0.0])
     # CoM displacement of state 3 (SPEC 3). m.
     state3_com_delta_m: list[float] = field(default_factory=lambda: [0.04, 0.0, 0.0])
-    # State 4 rises to an absolute CoM height: "+0.20 m" is out of reach on
-    # this model (0.376 m seated, ~0.55 m straight-legged); 0.526 m worked in
-    # the feasibility probe (SPEC 7). m.
-    standing_com_height_m: float = 0.526
+    # State 4's CoM path rises to this absolute height; the legs' state-4
+    # posture then straightens the knees to the erect stance (~0.58 m, knees
+    # -0.17 rad; controller.stance_*). A path to the erect height itself drove
+    # the knees onto their stop at the end of a fast, pulled rise: near
+    # straight legs 1 cm of CoM is 0.3 rad of knee (measured). 0.526 m (SPEC 7's
+    # probe) left the robot in a crouch. m.
+    standing_com_height_m: float = 0.56
     # 2 -> 3: feet carry this much together (SPEC 3)... N
     feet_force_2to3_N: float = 150.0
     # ... after at least this long in state 2. The authors' 1.5 s (SPEC 3) equals

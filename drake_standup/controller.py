@@ -198,6 +198,40 @@ class ControllerConfig:
             [0.2094, 0.1047, -0.1745, -0.0349, -1.6455, 0.4363, 0.5862, 0.2473, 0.0]
         )
     )
+    # State 4 ends with the legs, not the CoM height: over the last part of the rise
+    # (path progress from stance_from_progress to 1, smoothstep) the momentum task's
+    # vertical row fades to stance_vertical_weight_scale of its weight and the state-4
+    # posture (stance_posture_weight_by_joint) sets the knees, hence the height. Near
+    # straight legs 1 cm of CoM height is 0.3 rad of knee (measured): a CoM target there
+    # drove the knees onto their stop, and the soles slid (measured).
+    stance_from_progress: float = 0.7
+    stance_vertical_weight_scale: float = 1.0e-3
+    # Standup states in which the CoM target leans against the hands' pull so that the
+    # feet's CoP stays where it is without the pull (control/references.py: static_lean):
+    # standing, a 15 + 15 N pull per hand needed the CoP past the toes (measured).
+    lean_states: list[int] = field(default_factory=lambda: [4])
+    # Time constant of the lean's first-order filter: the pull's moment, not its jitter. s.
+    lean_filter_time_constant_s: float = 0.3
+    # The lean's bound per axis (x, y). m.
+    lean_max_m: float = 0.08
+    # Extra posture weights per joint in state 4 (a second posture task, active there
+    # only): near straight legs 1 cm of CoM height is 0.3 rad of knee, so the CoM target
+    # alone cannot place the knees (measured); the legs' posture sets them.
+    stance_posture_weight_by_joint: dict[str, float] = field(
+        default_factory=lambda: {
+            f"{side}_{joint}": weight
+            for side in "lr"
+            for joint, weight in (
+                ("hip_pitch", 10.0),
+                ("knee", 10.0),
+                ("ankle_pitch", 10.0),
+                ("shoulder_pitch", 3.0),
+                ("shoulder_roll", 3.0),
+                ("shoulder_yaw", 3.0),
+                ("elbow", 3.0),
+            )
+        }
+    )
     # QP solver: daqp (measured fastest, exact equalities), or Drake's osqp / clarabel.
     qp_solver: str = "daqp"
 
@@ -279,6 +313,7 @@ class ControllerTick:
     normal_forces_N: np.ndarray  # commanded f_z of every contact (CONTACTS), 0 if inactive
     helpful_force_W: np.ndarray  # f_par, N
     posture: np.ndarray  # next value of the posture state (see __init__)
+    lean_W: np.ndarray  # next value of the lean state, m
     inputs_s: float  # evaluating the input ports (and the upstream systems behind them)
     kinematics_s: float
     assembly_s: float
@@ -331,12 +366,20 @@ class WholeBodyController(LeafSystem):
             StandupSchedule(config, joints.names, joints.q_min, joints.q_max),
             as_slice(joints.q_indices),
             period_s,
+            weight_N=-plant.CalcTotalMass(plant.CreateDefaultContext(), [robot.model_instance])
+            * plant.gravity_field().gravity_vector()[2],
         )
         self._posture_weights = joint_values(
             joints.names,
             config.posture_weight_by_joint,
             "posture_weight_by_joint",
             config.posture_weight,
+        )
+        self._stance_weights = joint_values(
+            joints.names,
+            config.stance_posture_weight_by_joint,
+            "stance_posture_weight_by_joint",
+            0.0,
         )
         limited = joints.limited
         self._joint_limits = JointLimitBounds(
@@ -372,11 +415,14 @@ class WholeBodyController(LeafSystem):
         self._reference_port = self.DeclareVectorInputPort("com_reference", 9)
         self._plan_port = self.DeclareVectorInputPort("contact_plan", 3)
         self._hands_port = self.DeclareVectorInputPort("hand_wrenches_W", 12)
+        # Unconnected (unit tests): taken as 1, the segment finished.
+        self._progress_port = self.DeclareVectorInputPort("path_progress", 1)
         self._actuation = self.DeclareDiscreteState(nu)
         self._diagnostics = self.DeclareDiscreteState(len(self.DIAGNOSTICS))
         self._momentum_integral = self.DeclareDiscreteState(3)  # int L_ang dt, N m s^2
         # [latched flag, state-1 posture (nu), filtered posture reference (nu), base yaw].
         self._posture = self.DeclareDiscreteState(2 + 2 * nu)
+        self._lean = self.DeclareDiscreteState(3)  # the CoM target's lean, m
         self.DeclareStateOutputPort("actuation", self._actuation)
         self.DeclareStateOutputPort("diagnostics", self._diagnostics)
         # Initialization event: the plant's first step already sees computed torques.
@@ -404,6 +450,11 @@ class WholeBodyController(LeafSystem):
         com_reference = self._reference_port.Eval(context)
         plan = self._plan_port.Eval(context)
         F_hand_W = self._hands_port.Eval(context)
+        progress = (
+            float(self._progress_port.Eval(context)[0])
+            if self._progress_port.HasValue(context)
+            else 1.0
+        )
         t_inputs = time.perf_counter()
 
         standup_state, seat_scale, feet_scale = plan.tolist()
@@ -421,6 +472,8 @@ class WholeBodyController(LeafSystem):
             F_hand_W if pulled else None,
             state.get_value(self._momentum_integral),
             state.get_value(self._posture),
+            state.get_value(self._lean),
+            progress,
         )
         commands = self._contact_commands(program, references.state.seat_hinged, plan)
         t_tasks = time.perf_counter()
@@ -434,6 +487,7 @@ class WholeBodyController(LeafSystem):
             normal_forces_N=normal_forces_N,
             helpful_force_W=references.helpful_force_W,
             posture=references.next_posture,
+            lean_W=references.lean_W,
             inputs_s=t_inputs - t_start,
             kinematics_s=t_kinematics - t_inputs,
             assembly_s=t_tasks - t_kinematics + solution.assembly_s,
@@ -460,6 +514,16 @@ class WholeBodyController(LeafSystem):
                     self._posture_weights,
                     config.posture_kp_per_s2,
                     config.posture_damping_ratio,
+                ),
+                PostureTask(
+                    layout,
+                    self._joints.q_indices,
+                    self._joints.v_indices,
+                    self._stance_weights,
+                    config.posture_kp_per_s2,
+                    config.posture_damping_ratio,
+                    name="stance_posture",
+                    active_states=frozenset({4}),
                 ),
                 BaseOrientationTask(
                     layout,
@@ -527,6 +591,7 @@ class WholeBodyController(LeafSystem):
         integral = state.get_value(self._momentum_integral) + self._period_s * tick.terms.L_WCom[:3]
         discrete_state.set_value(self._momentum_integral, integral)
         discrete_state.set_value(self._posture, tick.posture)
+        discrete_state.set_value(self._lean, tick.lean_W)
         total_s = time.perf_counter() - t_start
         diagnostics = np.empty(len(self.DIAGNOSTICS))
         f_par = tick.helpful_force_W

@@ -131,6 +131,10 @@ def build_diagram(
         )
         builder.Connect(hand_wrenches, controller_system.GetInputPort("hand_wrenches_W"))
         builder.Connect(
+            reference.GetOutputPort("path_progress"),
+            controller_system.GetInputPort("path_progress"),
+        )
+        builder.Connect(
             controller_system.GetOutputPort("actuation"), plant.get_actuation_input_port(instance)
         )
 

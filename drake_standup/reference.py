@@ -47,7 +47,8 @@ class CoMReferenceGenerator(LeafSystem):
 
     Outputs com_reference (9: [x_d, xd_dot, xd_ddot], world), and x_d_W (3)
     and path_tangent_W (3: d_psi x_d), which depend on psi and segment only,
-    so the advancement can use them without an algebraic loop.
+    so the advancement can use them without an algebraic loop; path_progress
+    (1: (psi - psi_entry) / T in [0, 1], how far along the current segment).
     """
 
     def __init__(self):
@@ -77,6 +78,12 @@ class CoMReferenceGenerator(LeafSystem):
         self.DeclareVectorOutputPort(
             "path_tangent_W", 3, self._CalcTangent, prerequisites_of_calc=path_only
         )
+        self.DeclareVectorOutputPort(
+            "path_progress",
+            1,
+            self._CalcProgress,
+            prerequisites_of_calc={self._psi.ticket(), self._segment.ticket()},
+        )
 
     def _CalcReference(self, context: Context, output: BasicVector) -> None:
         x_d, d_x, dd_x = self._path.Eval(context)
@@ -93,3 +100,8 @@ class CoMReferenceGenerator(LeafSystem):
     def _CalcTangent(self, context: Context, output: BasicVector) -> None:
         d_x = self._path.Eval(context)[1]
         output.SetFromVector(d_x)
+
+    def _CalcProgress(self, context: Context, output: BasicVector) -> None:
+        segment = self._segment.Eval(context)
+        psi = self._psi.Eval(context)[0]
+        output.SetAtIndex(0, min(max((psi - segment[0]) / segment[1], 0.0), 1.0))

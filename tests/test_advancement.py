@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -97,6 +98,7 @@ def _simulate_advancement(cfg, v, omega_f, tangent, t_end):
     system.GetInputPort("omega_f_W").FixValue(context, omega_f)
     system.GetInputPort("path_tangent_W").FixValue(context, tangent)
     simulator = Simulator(system, context)
+    simulator.get_mutable_integrator().set_target_accuracy(1e-10)
     simulator.AdvanceTo(t_end)
     return system, context
 
@@ -108,15 +110,25 @@ def test_psi_equals_time_without_help():
     assert system.GetOutputPort("psi_ddot").Eval(context)[0] == 0.0
 
 
-def test_psi_integrates_the_law():
-    """Constant helpful inputs: psi(T) = ratio * T, the analytic integral."""
+def test_psi_integrates_the_rate_that_follows_the_law():
+    """Constant helpful inputs, law value r: psi_dot tends to r from 1 with time constant
+    tau, psi_dot(t) = r - (r - 1) e^(-t/tau), so psi(t) = r t - (r - 1) tau (1 - e^(-t/tau))
+    (the analytic integral), and psi_ddot = (r - psi_dot) / tau."""
     v = 1.6 * TANGENT
     omega_f = TANGENT / np.linalg.norm(TANGENT)
-    ratio = (v @ TANGENT) / (TANGENT @ TANGENT + CFG.eps)
-    system, context = _simulate_advancement(CFG, v, omega_f, TANGENT, 2.0)
-    assert system.GetOutputPort("psi").Eval(context)[0] == pytest.approx(2.0 * ratio, rel=1e-9)
-    # psi_ddot is the derivative of the low-passed psi_dot: decayed after 40 tau.
-    assert abs(system.GetOutputPort("psi_ddot").Eval(context)[0]) < 1e-6
+    r = (v @ TANGENT) / (TANGENT @ TANGENT + CFG.eps)
+    tau = CFG.psi_ddot_filter_s
+    for t in (0.03, 0.1, 2.0):
+        system, context = _simulate_advancement(CFG, v, omega_f, TANGENT, t)
+        decay = math.exp(-t / tau)
+        psi = r * t - (r - 1.0) * tau * (1.0 - decay)
+        psi_dot = r - (r - 1.0) * decay
+        assert system.GetOutputPort("psi").Eval(context)[0] == pytest.approx(psi, rel=1e-6)
+        assert system.GetOutputPort("psi_dot").Eval(context)[0] == pytest.approx(psi_dot, rel=1e-6)
+        assert system.GetOutputPort("psi_ddot").Eval(context)[0] == pytest.approx(
+            (r - psi_dot) / tau, rel=1e-5, abs=1e-9
+        )
+        assert system.GetOutputPort("psi_dot_law").Eval(context)[0] == pytest.approx(r)
 
 
 def test_lead_gate_waits_while_the_com_lags():

@@ -11,7 +11,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import Scenario
 from drake_standup.control.qp import ContactCommands, ContactMap, QpLayout, Task, WholeBodyQp
-from drake_standup.control.references import TaskReferences
+from drake_standup.control.references import TaskReferences, static_lean
 from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.controller import ControllerConfig, WholeBodyController
 from drake_standup.scene import add_scene, set_seated_state
@@ -46,6 +46,8 @@ def _references(standup_state: int) -> TaskReferences:
         q_reference=None,
         R_WB_target=None,
         helpful_force_W=np.zeros(3),
+        lean_W=np.zeros(3),
+        vertical_weight_scale=1.0,
         next_posture=None,
     )
 
@@ -109,3 +111,31 @@ def test_a_new_task_acts_only_in_its_active_states(seated):
         else:
             np.testing.assert_array_equal(solution.vdot, reference.vdot)
             np.testing.assert_array_equal(solution.tau, reference.tau)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_static_lean_keeps_the_centre_of_pressure_where_it_was(seed):
+    """Static balance, computed independently about the world origin: with the CoM moved
+    by static_lean's shift and the pull on, the ground reaction's CoP (on z = 0) lands
+    where the CoM stood before the shift, i.e. where the CoP is without the pull."""
+    rng = np.random.default_rng(seed)
+    weight_N = 324.0
+    com = np.array([0.2, 0.0, 0.57]) + rng.uniform(-0.02, 0.02, 3)  # where it leans to
+    hand = com + np.array([0.2, 0.0, 0.3]) + rng.uniform(-0.1, 0.1, 3)
+    f = rng.uniform(-30.0, 30.0, 3)
+    tau_com = np.cross(hand - com, f)
+    lean = static_lean(np.r_[tau_com, f], com[2], weight_N, max_lean_m=1.0)
+    assert lean[2] == 0.0
+    gravity = np.array([0.0, 0.0, -weight_N])
+    moment_O = np.cross(com, gravity) + np.cross(hand, f)
+    reaction_z = -(gravity + f)[2]
+    cop = np.array([moment_O[1] / reaction_z, -moment_O[0] / reaction_z])
+    np.testing.assert_allclose(cop, (com - lean)[:2], atol=1e-12)
+
+
+def test_static_lean_is_bounded_and_zero_without_a_pull():
+    assert not static_lean(np.zeros(6), 0.57, 324.0, 0.08).any()
+    big = static_lean(np.r_[0.0, 0.0, 0.0, 300.0, -300.0, 0.0], 0.57, 324.0, 0.08)
+    np.testing.assert_allclose(big, [-0.08, 0.08, 0.0])
+    # A pull that lifts the robot off its feet: no static answer, no lean.
+    assert not static_lean(np.r_[0.0, 5.0, 0.0, 10.0, 0.0, 400.0], 0.57, 324.0, 0.08).any()

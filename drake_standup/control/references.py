@@ -113,6 +113,8 @@ class StateReferences:
     posture_hold: np.ndarray  # True: the joint holds the first tick's posture
     base_pitch_rad: float  # forward pitch of the base target
     seat_hinged: bool  # the seat leaves the pelvis' pitch about the hip axis free
+    lean: bool  # the CoM target leans against the pull (the feet alone carry the robot)
+    stance: bool  # the legs' posture, not the CoM height, ends the segment (state 4)
 
 
 class StandupSchedule:
@@ -146,6 +148,8 @@ class StandupSchedule:
                 np.isnan(tables[state]),
                 config.base_pitch_by_state_rad[state - 1],
                 state >= config.seat_hinge_from_state,
+                state in config.lean_states,
+                state == STATES[-1],
             )
             for state in STATES
         }
@@ -165,9 +169,37 @@ class TaskReferences:
     q_reference: np.ndarray  # (nu,) filtered posture reference, rad
     R_WB_target: np.ndarray  # (3, 3) base target orientation
     helpful_force_W: np.ndarray  # f_par, N (zero: no pull)
+    lean_W: np.ndarray  # (3,) the CoM target's lean against the pull this tick, m
+    # The momentum task's vertical row weight, a fraction of its weight (state 4's end).
+    vertical_weight_scale: float
     # The posture state after this tick: [latched flag, first tick's posture (nu),
     # q_ref's next value (nu), first tick's base yaw].
     next_posture: np.ndarray
+
+
+def static_lean(
+    hand_wrench_Com: np.ndarray, com_height_m: float, weight_N: float, max_lean_m: float
+) -> np.ndarray:
+    """(3,) CoM shift (x, y; z = 0) that keeps the feet's centre of pressure where it is
+    without the pull, in static balance.
+
+    hand_wrench_Com = [tau; f], the hands' resultant about the CoM (W, N m / N). With the
+    CoM at height h above the soles and the ground reaction R = -(f + m g) acting at the
+    CoP p, the moments about the CoM balance when
+
+        p_x - c_x = (tau_y + h f_x) / (m g - f_z),   p_y - c_y = -(tau_x - h f_y) / (m g - f_z):
+
+    so the CoM moves by -(tau_y + h f_x) / (m g - f_z) in x and (tau_x - h f_y) / (m g - f_z)
+    in y for the CoP to stay put. Clipped to max_lean_m (each axis); zero if the pull
+    would lift the robot."""
+    tau, f = hand_wrench_Com[:3], hand_wrench_Com[3:]
+    support = weight_N - f[2]
+    if support <= 0.0:
+        return np.zeros(3)
+    lean = np.array(
+        [-(tau[1] + com_height_m * f[0]) / support, (tau[0] - com_height_m * f[1]) / support, 0.0]
+    )
+    return np.clip(lean, -max_lean_m, max_lean_m)
 
 
 class ReferenceGenerator:
@@ -180,8 +212,10 @@ class ReferenceGenerator:
         schedule: StandupSchedule,
         q_joints: slice | np.ndarray,
         period_s: float,
+        weight_N: float = 0.0,
     ):
-        """q_joints: the actuated joints' entries of q, in the schedule's order."""
+        """q_joints: the actuated joints' entries of q, in the schedule's order; weight_N:
+        the robot's weight m g (the plant's gravity), for the lean against the pull."""
         self._config = config
         self.schedule = schedule
         self._q_joints = q_joints
@@ -190,6 +224,30 @@ class ReferenceGenerator:
         self._latched = np.ones(1)  # the posture state's latched flag
         # The base's target orientation for the last (yaw, pitch), rad.
         self._base_target = (None, None), None
+        self._weight_N = weight_N
+        self._lean_blend = min(period_s / config.lean_filter_time_constant_s, 1.0)
+
+    def _lean(
+        self,
+        terms: RobotTerms,
+        state: StateReferences,
+        F_hand_W: np.ndarray | None,
+        lean_W: np.ndarray | None,
+    ) -> np.ndarray:
+        """The lean's next value: static_lean of the measured pull, first-order filtered
+        (lean_filter_time_constant_s), in the states that stand on the feet alone; it
+        decays back to zero in the others and when the pull stops."""
+        lean = np.zeros(3) if lean_W is None else lean_W
+        target = np.zeros(3)
+        if state.lean and F_hand_W is not None:
+            wrench = terms.J_W.reshape(len(F_hand_W), -1).T[:6] @ F_hand_W
+            wrench[:3] -= np.cross(terms.p_BoCom, wrench[3:])
+            target = static_lean(
+                wrench, float(terms.p_WCom[2]), self._weight_N, self._config.lean_max_m
+            )
+        if not (target.any() or lean.any()):
+            return lean
+        return lean + self._lean_blend * (target - lean)
 
     def calc(
         self,
@@ -199,12 +257,20 @@ class ReferenceGenerator:
         F_hand_W: np.ndarray | None,
         momentum_integral: np.ndarray,
         posture: np.ndarray,
+        lean_W: np.ndarray | None = None,
+        path_progress: float = 1.0,
     ) -> TaskReferences:
         """com_reference = [x_d, xd_dot, xd_ddot] (9,); F_hand_W = [tau_l, f_l, tau_r, f_r]
         (None: no pull); momentum_integral = int L_ang dt; posture: the posture state
-        before this tick (TaskReferences.next_posture)."""
+        before this tick (TaskReferences.next_posture); lean_W: the lean's filtered value
+        before this tick (None: zero); path_progress: how far along its segment the CoM
+        reference is, 0-1."""
         config = self._config
         state = self.schedule[standup_state]
+        lean = self._lean(terms, state, F_hand_W, lean_W)
+        if lean.any():
+            com_reference = com_reference.copy()
+            com_reference[:3] += lean
         xddot_star = com_acceleration_reference(
             terms.p_WCom, terms.v_WCom, com_reference, state.com_kp_per_s2, state.com_kd_per_s
         )
@@ -212,6 +278,13 @@ class ReferenceGenerator:
         Ldot_star[:3] = -config.angular_momentum_kd_per_s * terms.L_WCom[:3]
         Ldot_star[:3] -= config.angular_momentum_kp_per_s2 * momentum_integral
         Ldot_star[3:] = terms.mass_kg * xddot_star
+        vertical_weight_scale = 1.0
+        if state.stance:
+            stance = _smoothstep(
+                (path_progress - config.stance_from_progress)
+                / (1.0 - config.stance_from_progress)
+            )
+            vertical_weight_scale -= stance * (1.0 - config.stance_vertical_weight_scale)
         tau_hand = None
         f_par = np.zeros(3)
         if F_hand_W is not None:
@@ -257,5 +330,7 @@ class ReferenceGenerator:
             q_reference=q_reference,
             R_WB_target=self._base_target[1],
             helpful_force_W=f_par,
+            lean_W=lean,
+            vertical_weight_scale=vertical_weight_scale,
             next_posture=np.concatenate((self._latched, q_initial, q_next, (base_yaw,))),
         )

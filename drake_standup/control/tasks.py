@@ -44,7 +44,8 @@ class MomentumTask(Task):
         W_gravity: np.ndarray,
         weight: float,
     ):
-        self.weight = weight
+        self._weight = weight
+        self.weight = np.full(6, weight)
         self.columns = layout.wrenches
         self.A = np.empty((6, layout.n_wrench))
         self.b = np.empty(6)
@@ -53,6 +54,7 @@ class MomentumTask(Task):
 
     def update(self, terms: RobotTerms, references: TaskReferences) -> None:
         A, b = self.A, self.b
+        self.weight[5] = self._weight * references.vertical_weight_scale
         A[:] = self._contact_map(terms)[:, :6].T
         A[:3] -= skew(terms.p_BoCom) @ A[3:]
         np.subtract(references.Ldot_star, self._W_gravity, out=b)
@@ -100,7 +102,13 @@ class PostureTask(Task):
         weights: np.ndarray,
         kp_per_s2: float,
         damping_ratio: float,
+        name: str = "posture",
+        active_states: frozenset[int] | None = None,
     ):
+        """name, active_states: a second posture task (e.g. extra weights in one state)."""
+        self.name = name
+        if active_states is not None:
+            self.active_states = frozenset(active_states)
         first, last = int(v_indices.min()), int(v_indices.max())
         self.weight = np.asarray(weights, dtype=float)
         self.columns = slice(layout.vdot.start + first, layout.vdot.start + last + 1)
