@@ -146,6 +146,12 @@ class AdvancementConfig:
     # alpha (hand-induced CoM acceleration along the path) above which the
     # interaction counts as helpful: ~1.6 N of net pull along the path. m/s^2.
     alpha_min_mps2: float = 0.05
+    # alpha from which the law acts in full (advancement.py: graded gates); in
+    # between, psi_dot's excess over 1 is weighted by (alpha - alpha_min) /
+    # (alpha_full - alpha_min). alpha_full <= alpha_min: the paper's on/off
+    # gate. The default pull (15 + 15 N per hand) gives alpha ~0.9 m/s^2 at
+    # its peak (measured). m/s^2.
+    alpha_full_mps2: float = 1.0
     # Advance only while the CoM is not behind its reference along the path
     # (see advancement.py: without it the law and the tracker run away). The
     # tolerance admits the tracker's steady lag. m.
@@ -182,7 +188,7 @@ class StandupConfig:
     # the knees onto their stop at the end of a fast, pulled rise: near
     # straight legs 1 cm of CoM is 0.3 rad of knee (measured). 0.526 m (SPEC 7's
     # probe) left the robot in a crouch. m.
-    standing_com_height_m: float = 0.56
+    standing_com_height_m: float = 0.57
     # 2 -> 3: feet carry this much together (SPEC 3)... N
     feet_force_2to3_N: float = 150.0
     # ... after at least this long in state 2. The authors' 1.5 s (SPEC 3) equals
@@ -661,6 +667,7 @@ def _validate_advancement(adv: AdvancementConfig) -> None:
     _positive("advancement.eps", adv.eps)
     _positive("advancement.alpha_min_mps2", adv.alpha_min_mps2, allow_zero=True)
     _positive("advancement.lag_tolerance_m", adv.lag_tolerance_m, allow_zero=True)
+    _positive("advancement.alpha_full_mps2", adv.alpha_full_mps2, allow_zero=True)
     _positive("advancement.psi_ddot_filter_s", adv.psi_ddot_filter_s)
 
 

@@ -209,11 +209,11 @@ class ControllerConfig:
     # Standup states in which the CoM target leans against the hands' pull so that the
     # feet's CoP stays where it is without the pull (control/references.py: static_lean):
     # standing, a 15 + 15 N pull per hand needed the CoP past the toes (measured).
-    lean_states: list[int] = field(default_factory=lambda: [4])
+    lean_states: list[int] = field(default_factory=lambda: [3, 4])
     # Time constant of the lean's first-order filter: the pull's moment, not its jitter. s.
     lean_filter_time_constant_s: float = 0.3
     # The lean's bound per axis (x, y). m.
-    lean_max_m: float = 0.08
+    lean_max_m: float = 0.15
     # Extra posture weights per joint in state 4 (a second posture task, active there
     # only): near straight legs 1 cm of CoM height is 0.3 rad of knee, so the CoM target
     # alone cannot place the knees (measured); the legs' posture sets them.

@@ -113,3 +113,24 @@ def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -
         RigidTransform(RollPitchYaw(init.base_rpy_rad), init.base_xyz_m),
     )
     plant.SetVelocities(plant_context, instance, 0.0 * plant.GetVelocities(plant_context, instance))
+
+
+def erect_com_height_m(scene: Scene, scenario: Scenario, posture_rad: dict[str, float]) -> float:
+    """The CoM's height above the floor in a standing posture: the joints named in
+    posture_rad at their values (the others as seated), the base upright at the seated
+    yaw, the soles at the height they rest at on the floor when seated. With the sagittal
+    leg angles summing to zero (hip pitch + knee + ankle pitch, as in the authors' state-4
+    posture) the soles are then flat on the floor (checked by the caller's tests)."""
+    plant = scene.plant
+    instance = scene.robot.model_instance
+    context = plant.CreateDefaultContext()
+    set_seated_state(scene, context, scenario)
+    soles = [scene.robot.frame(plant, name) for name in ("l_sole", "r_sole")]
+    sole_z_seated = [frame.CalcPoseInWorld(context).translation()[2] for frame in soles]
+    set_joint_positions(plant, context, instance, posture_rad)
+    root = plant.GetBodyByName("root_link", instance)
+    yaw = scenario.initial.base_rpy_rad[2]
+    plant.SetFreeBodyPose(context, root, RigidTransform(RollPitchYaw(0.0, 0.0, yaw), [0, 0, 1]))
+    sole_z = [frame.CalcPoseInWorld(context).translation()[2] for frame in soles]
+    com_z = plant.CalcCenterOfMassPositionInWorld(context, [instance])[2]
+    return float(com_z - min(sole_z) + min(sole_z_seated))

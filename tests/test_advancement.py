@@ -16,7 +16,10 @@ from drake_standup.config import AdvancementConfig
 from drake_standup.robot import ContactModel, add_icub
 from drake_standup.sensing import RobotSensing
 
-CFG = AdvancementConfig()
+# The paper's on/off law (alpha_full <= alpha_min): the laws' values below are the
+# paper's and the authors' formulas; the graded gates have tests of their own.
+CFG = AdvancementConfig(alpha_full_mps2=0.0)
+GRADED = AdvancementConfig()
 TANGENT = np.array([0.12, 0.0, 0.02])  # a state-2-like path tangent, m per unit psi
 
 
@@ -131,6 +134,35 @@ def test_psi_integrates_the_rate_that_follows_the_law():
         assert system.GetOutputPort("psi_dot_law").Eval(context)[0] == pytest.approx(r)
 
 
+def test_graded_gate_weights_the_laws_excess_by_the_help():
+    """Between alpha_min and alpha_full psi_dot = 1 + w (clip(ratio) - 1) with w linear
+    in alpha: continuous at alpha_min (psi_dot -> 1), the paper's value from alpha_full."""
+    v = 1.8 * TANGENT
+    unit = TANGENT / np.linalg.norm(TANGENT)
+    ratio = (v @ TANGENT) / (TANGENT @ TANGENT + GRADED.eps)
+    lo, hi = GRADED.alpha_min_mps2, GRADED.alpha_full_mps2
+    for alpha in np.linspace(lo + 1e-9, hi, 7):
+        w = (alpha - lo) / (hi - lo)
+        assert psi_dot_law(GRADED, v, alpha * unit, TANGENT)[0] == pytest.approx(
+            1.0 + w * (ratio - 1.0), rel=1e-12
+        )
+    assert psi_dot_law(GRADED, v, (lo + 1e-9) * unit, TANGENT)[0] == pytest.approx(1.0)
+    assert psi_dot_law(GRADED, v, 3.0 * hi * unit, TANGENT)[0] == pytest.approx(ratio)
+
+
+def test_graded_lead_gate_is_continuous_in_the_lag():
+    """The gate's weight is 1 + lead / lag_tolerance between a lag of lag_tolerance (0)
+    and no lag (1): no jump of psi_dot when the lag crosses the tolerance."""
+    v = 1.8 * TANGENT
+    omega_f = 2.0 * TANGENT / np.linalg.norm(TANGENT)  # above alpha_full: w = 1
+    ratio = (v @ TANGENT) / (TANGENT @ TANGENT + GRADED.eps)
+    tol = GRADED.lag_tolerance_m
+    for lag in np.linspace(0.0, tol, 6):
+        expected = 1.0 + (1.0 - lag / tol) * (ratio - 1.0)
+        assert psi_dot_law(GRADED, v, omega_f, TANGENT, -lag)[0] == pytest.approx(expected)
+    assert psi_dot_law(GRADED, v, omega_f, TANGENT, -2.0 * tol)[0] == 1.0
+
+
 def test_lead_gate_waits_while_the_com_lags():
     """Helped and fast, but 1 cm behind the reference along the path: no
     advancement with the gate (the default), the paper's ratio without it."""
@@ -142,8 +174,9 @@ def test_lead_gate_waits_while_the_com_lags():
     assert lag == pytest.approx(-0.01)
     assert psi_dot_law(CFG, v, omega_f, TANGENT, lag)[0] == 1.0
     assert psi_dot_law(_cfg(lead_gate=False), v, omega_f, TANGENT, lag)[0] > 1.7
-    # Within the tolerance (the tracker's steady lag) it advances.
-    assert psi_dot_law(CFG, v, omega_f, TANGENT, -0.004)[0] > 1.7
+    # Within the tolerance (the tracker's steady lag) it advances, fully on a lead.
+    assert psi_dot_law(CFG, v, omega_f, TANGENT, -0.004)[0] > 1.0
+    assert psi_dot_law(CFG, v, omega_f, TANGENT, 0.001)[0] > 1.7
 
 
 def test_omega_f_matches_the_papers_formula():

@@ -269,8 +269,13 @@ class ReferenceGenerator:
         state = self.schedule[standup_state]
         lean = self._lean(terms, state, F_hand_W, lean_W)
         if lean.any():
+            # Leaning is tilting about the feet: the CoM target keeps its distance from
+            # the floor point below the unleaned target, so it drops as it leans (2 cm at
+            # a 15 cm lean); an unchanged height asked for legs longer than straight.
             com_reference = com_reference.copy()
-            com_reference[:3] += lean
+            height = com_reference[2]
+            com_reference[:2] += lean[:2]
+            com_reference[2] = math.sqrt(max(height * height - lean[0] ** 2 - lean[1] ** 2, 0.0))
         xddot_star = com_acceleration_reference(
             terms.p_WCom, terms.v_WCom, com_reference, state.com_kp_per_s2, state.com_kd_per_s
         )
@@ -279,6 +284,7 @@ class ReferenceGenerator:
         Ldot_star[:3] -= config.angular_momentum_kp_per_s2 * momentum_integral
         Ldot_star[3:] = terms.mass_kg * xddot_star
         vertical_weight_scale = 1.0
+        stance = 0.0
         if state.stance:
             stance = _smoothstep(
                 (path_progress - config.stance_from_progress)
@@ -298,6 +304,9 @@ class ReferenceGenerator:
                 config.help_fade_speed_mps,
                 config.help_max_lead_m,
             )
+            # The legs end the rise (stance): the whole pull is compensated there, or
+            # the help carried the CoM onto straight, locked knees (measured).
+            f_par *= 1.0 - stance
             Ldot_star[3:] += f_par
             tau_hand = terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
 
