@@ -105,12 +105,17 @@ class ControllerConfig:
     # Posture targets are clamped this far inside the joint limits: SPEC 3's elbow target
     # 0.2473 rad lies below the URDF's 0.262 limit. rad.
     posture_limit_margin_rad: float = 0.05
-    # Joints off the legs (torso, neck, arms) get acceleration bounds that stop them at
-    # their limits within this horizon (control/tasks.py): without them the arms, swung to
-    # move the CoM in state 2, hit the shoulder-pitch limit and the jolt threw the pelvis
-    # off the seat (measured). The legs get none: the held soles pin their accelerations,
-    # and a bound could make the QP infeasible (it did, on random states). s.
+    # Every actuated joint gets acceleration bounds that stop it at its limits within
+    # this horizon (control/tasks.py). Without them the arms, swung to move the CoM in
+    # state 2, hit the shoulder-pitch limit and the jolt threw the pelvis off the seat;
+    # the knees, straightened by a pulled rise, hit their stop at 8 rad/s and the robot
+    # hopped (measured). s.
     joint_limit_horizon_s: float = 0.1
+    # The bounds are soft: a slack s per joint may exceed them at the cost w s^2
+    # (rad/s^2). Hard bounds made the QP infeasible where the held soles pin the legs'
+    # accelerations (random states; the knees of a rising robot) or the pull holds the
+    # shoulders at their limit (measured); the slack's use is reported.
+    joint_limit_weight: float = 1.0e3
     # Base (root_link) orientation: upright at the yaw of the first tick, pitched forward
     # by base_pitch_by_state_rad. The probe ended stooped 25 deg (SPEC 7). 1/s^2.
     base_orientation_kp_per_s2: float = 30.0
@@ -225,10 +230,10 @@ class ControllerConfig:
                 ("hip_pitch", 10.0),
                 ("knee", 10.0),
                 ("ankle_pitch", 10.0),
-                ("shoulder_pitch", 3.0),
-                ("shoulder_roll", 3.0),
-                ("shoulder_yaw", 3.0),
-                ("elbow", 3.0),
+                ("shoulder_pitch", 10.0),
+                ("shoulder_roll", 10.0),
+                ("shoulder_yaw", 10.0),
+                ("elbow", 10.0),
             )
         }
     )
@@ -381,12 +386,8 @@ class WholeBodyController(LeafSystem):
             "stance_posture_weight_by_joint",
             0.0,
         )
-        limited = joints.limited
         self._joint_limits = JointLimitBounds(
-            joints.q_indices[limited],
-            joints.v_indices[limited],
-            joints.q_min[limited],
-            joints.q_max[limited],
+            joints.q_indices, joints.v_indices, joints.q_min, joints.q_max,
             config.joint_limit_horizon_s,
         )
         self._kinematics = RobotKinematics(
@@ -540,7 +541,8 @@ class WholeBodyController(LeafSystem):
                 wrench_weight=config.wrench_weight,
                 acceleration_weight=config.acceleration_weight,
                 tasks=tasks,
-                acceleration_bounds=self._joint_limits,
+                soft_bounds=self._joint_limits,
+                soft_bound_weight=config.joint_limit_weight,
                 solver=config.qp_solver,
             )
             soles = np.array([spec.frame in ("l_sole", "r_sole") for spec in contacts])

@@ -33,7 +33,7 @@ strictly convex), and daqp solves it 10-20 % faster without their nu rows (measu
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Protocol
 
@@ -130,6 +130,7 @@ class QpSolution:
     assembly_s: float
     solve_s: float
     frame_rotations: Callable[[], np.ndarray]  # () -> the contact frames' R_WC (nc, 3, 3)
+    slack: np.ndarray = field(default_factory=lambda: np.zeros(0))  # soft bounds' s
 
     @cached_property
     def F_W(self) -> np.ndarray:
@@ -211,11 +212,16 @@ class WholeBodyQp:
         acceleration_weight: float,
         tasks: list[Task],
         acceleration_bounds: AccelerationBounds | None = None,
+        soft_bounds: AccelerationBounds | None = None,
+        soft_bound_weight: float = 0.0,
         solver: str = "daqp",
     ):
         """contact_map: the active contacts and their map (the tasks may share it).
         tasks: the cost's tasks. acceleration_bounds: bounds on entries of vdot, computed
-        each tick (None: none)."""
+        each tick (None: none). soft_bounds: bounds that a slack s >= 0 per entry may
+        exceed, vdot_min - s <= vdot <= vdot_max + s, at the cost soft_bound_weight s^2
+        (the slacks come last in z, after the layout's unknowns): the program stays
+        feasible whatever the state."""
         nv, nu = B.shape
         if not (np.all((B == 0) | (B == 1)) and np.all(B.sum(axis=0) == 1)):
             raise ValueError("the actuation matrix B must select one velocity per actuator")
@@ -226,7 +232,11 @@ class WholeBodyQp:
         self._solver = solver
         self._torque_limit_Nm = torque_limit_Nm
         self._torque_weight = torque_weight
-        n, nw, nc = layout.n, layout.n_wrench, len(contacts)
+        nw, nc = layout.n_wrench, len(contacts)
+        self._soft_bounds = soft_bounds
+        n_soft = 0 if soft_bounds is None else len(soft_bounds.v_indices)
+        self.n = n = layout.n + n_soft  # unknowns: the layout's, then the slacks
+        self._slack = slice(layout.n, n)
 
         # Rows of A: accelerations of the constrained contacts (6 each), cones (10 per
         # contact), then the rows of (1): the six base rows and, last, the torques (nu),
@@ -238,8 +248,10 @@ class WholeBodyQp:
         cones = [wrench_cone_matrix(spec) for spec in contacts]
         row = rows_acc.stop
         rows_cones = slice(row, row + sum(len(K) for K in cones))
-        rows_dynamics = slice(rows_cones.stop, rows_cones.stop + N_BASE + nu)
-        self._rows_tau = slice(rows_cones.stop + N_BASE, rows_dynamics.stop)
+        # Soft bounds: vdot_i - s_i <= vdot_max_i, then vdot_i + s_i >= vdot_min_i.
+        rows_soft = slice(rows_cones.stop, rows_cones.stop + 2 * n_soft)
+        rows_dynamics = slice(rows_soft.stop, rows_soft.stop + N_BASE + nu)
+        self._rows_tau = slice(rows_dynamics.start + N_BASE, rows_dynamics.stop)
         m = self._rows_tau.stop
         self._A = A = np.zeros((m, n))
         self._lo = lo = np.full(n + m, -np.inf)
@@ -251,6 +263,17 @@ class WholeBodyQp:
             A[cone, layout.wrench(c)] = K
             hi[self._bounds(cone)] = 0.0
         self._equality[self._bounds(slice(rows_dynamics.start, self._rows_tau.start))] = 1
+        if n_soft:
+            entries = np.arange(n_soft)
+            columns = layout.vdot.start + np.asarray(soft_bounds.v_indices, dtype=int)
+            A[rows_soft.start + entries, columns] = 1.0
+            A[rows_soft.start + entries, self._slack.start + entries] = -1.0
+            A[rows_soft.start + n_soft + entries, columns] = 1.0
+            A[rows_soft.start + n_soft + entries, self._slack.start + entries] = 1.0
+            lo[self._slack] = 0.0
+            bounds = self._bounds(rows_soft)
+            self._soft_hi = hi[bounds][:n_soft]
+            self._soft_lo = lo[bounds][n_soft:]
         # The constrained contacts' rows are equalities (all rows held) until solve() gets
         # ContactCommands.partially_held: the last one it got.
         self._equality[self._bounds(rows_acc)] = 1
@@ -278,7 +301,13 @@ class WholeBodyQp:
             self._bounded_vdot = nw + np.asarray(acceleration_bounds.v_indices, dtype=int)
 
         self._H_regularisation = np.diag(
-            np.concatenate([np.full(nw, wrench_weight), np.full(nv, acceleration_weight)])
+            np.concatenate(
+                [
+                    np.full(nw, wrench_weight),
+                    np.full(nv, acceleration_weight),
+                    np.full(n_soft, soft_bound_weight),
+                ]
+            )
         )
         self.tasks = list(tasks)
         # standup state -> its _ActiveTasks (states with the same active tasks share one).
@@ -300,14 +329,14 @@ class WholeBodyQp:
 
     def _bounds(self, rows: slice) -> slice:
         """Entries of lo, hi (after the n simple bounds) that belong to rows of A."""
-        n = self.layout.n
+        n = self.n
         return slice(n + rows.start, n + rows.stop)
 
     def _precompute(self, tasks: list[Task]) -> _ActiveTasks:
         """For a set of active tasks: H_fixed = regularisation + w A^T A of those with a
         constant A, g_fixed = -w A^T b of the constant ones, in the tasks' order."""
         H = self._H_regularisation.copy()
-        g = np.zeros(self.layout.n)
+        g = np.zeros(self.n)
         tracking = []
         for task in tasks:
             if not task.constant_A:
@@ -368,7 +397,7 @@ class WholeBodyQp:
             self._free_rows = np.concatenate(free) if free else None
             self._equality[self._bounds(slice(0, len(self._lo_acc)))] = 1
             if self._free_rows is not None:
-                self._equality[self.layout.n + self._free_rows] = 0
+                self._equality[self.n + self._free_rows] = 0
         if self._free_rows is not None:
             self._lo_acc[self._free_rows] = -np.inf
             self._hi_acc[self._free_rows] = np.inf
@@ -379,6 +408,8 @@ class WholeBodyQp:
             vdot_min, vdot_max = self._acceleration_bounds.calc(terms)
             lo[self._bounded_vdot] = vdot_min
             hi[self._bounded_vdot] = vdot_max
+        if self._soft_bounds is not None:
+            self._soft_lo[:], self._soft_hi[:] = self._soft_bounds.calc(terms)
 
         # Cost: w_tau ||T z + t0||^2 with t0 = -r[actuated], the tasks, the fixed part.
         T = self._T
@@ -416,7 +447,8 @@ class WholeBodyQp:
         return QpSolution(
             frames=list(self.frames),
             ok=ok,
-            vdot=z[nw:],
+            vdot=z[self.layout.vdot],
+            slack=z[self._slack],
             F_C=F_C,
             tau=tau,
             assembly_s=t_assembled - t_start,
