@@ -1,9 +1,14 @@
 """HumanWrenchSource: the helper's hands on the robot's hands.
 
 Two humans: 'scripted' applies the scenario's pulls (trapezoids in time, each
-on one hand, constant world direction); 'reactive' pulls each hand toward a
-target that leaves from where the hand was and moves up and forward, like a
-person guiding the robot up: an impedance with a force cap.
+on one hand, constant world direction); 'reactive' guides each hand, like a
+person helping the robot up, in one of two ways (reactive.guide):
+- velocity: an impedance pulling toward a target that leaves from where the
+  hand was and moves up and forward at a constant velocity, force capped.
+- path: a person walking the hand along a path at a human pace, following the
+  robot: the target stays between lead_min and lead_max ahead of the hand
+  along the path, the pull acts along the path only and only forwards along
+  it, capped, and eases off once the robot is up (path_force).
 The wrench acts at the origin of the hand task frame (the hand's DH frame).
 """
 
@@ -61,6 +66,88 @@ def reactive_force(
     return scale * f
 
 
+class Path:
+    """A polyline in the sagittal (x, z) plane from [0, 0] through waypoints,
+    parametrised by arc length s."""
+
+    def __init__(self, waypoints_xz: list[list[float]]):
+        self.points = np.vstack([np.zeros(2), np.asarray(waypoints_xz, dtype=float)])
+        self.lengths = np.linalg.norm(np.diff(self.points, axis=0), axis=1)
+        self.s_start = np.concatenate([[0.0], np.cumsum(self.lengths)])
+        self.length = float(self.s_start[-1])
+        self.tangents = np.diff(self.points, axis=0) / self.lengths[:, None]
+
+    def point(self, s: float) -> np.ndarray:
+        """The path's point at arc length s (clamped to the path). (x, z)."""
+        s = min(max(s, 0.0), self.length)
+        i = min(int(np.searchsorted(self.s_start, s, side="right")) - 1, len(self.lengths) - 1)
+        return self.points[i] + (s - self.s_start[i]) * self.tangents[i]
+
+    def project(self, p: np.ndarray) -> tuple[float, np.ndarray]:
+        """(s, unit tangent) of the path's point closest to p (x, z)."""
+        best = (np.inf, 0.0, self.tangents[0])
+        for i, (a, t, length) in enumerate(zip(self.points, self.tangents, self.lengths)):
+            u = min(max(float((p - a) @ t), 0.0), length)
+            d = float(np.linalg.norm(p - (a + u * t)))
+            if d < best[0] - 1e-12:
+                best = (d, self.s_start[i] + u, t)
+        return best[1], best[2]
+
+
+def _xz(v: np.ndarray) -> np.ndarray:
+    return np.array([v[0], v[2]])
+
+
+def path_force(
+    cfg: ReactiveHumanConfig,
+    path: Path,
+    t: float,
+    p_hand: np.ndarray,
+    v_hand: np.ndarray,
+    p_start: np.ndarray,
+    com_rise_m: float,
+) -> np.ndarray:
+    """A person walking one hand along path (from p_start), capped. World, N.
+
+    The hand's progress s_h is its closest point on the path (its sideways
+    position is ignored). The person's own progress would be pace (t - start),
+    but they never get more than lead_max ahead of the hand (no yank) and
+    keep at least lead_min ahead (they follow a hand that outruns them with a
+    light pull), never past the path's end:
+        s_t = min(L, clip(pace (t - start), s_h + lead_min, s_h + lead_max)).
+    The pull K (s_t - s_h) + D (ds_t/dt - ds_h/dt), clipped to [0, cap], acts
+    along the path from the hand's closest point toward the target's point
+    (the path's tangent, turning with it through a corner): only forwards
+    along the path, no force across it or sideways. It fades in and out with
+    the trapezoid (start_s, duration_s, ramp_s) and fades out while the CoM
+    rises through ease_com_rise_m.
+    """
+    scale = trapezoid(t, cfg.start_s, cfg.duration_s, cfg.ramp_s)
+    low, high = cfg.ease_com_rise_m
+    scale *= min(1.0, max(0.0, (high - com_rise_m) / (high - low)))
+    if scale == 0.0:
+        return np.zeros(3)
+    s_hand, tangent = path.project(_xz(p_hand - p_start))
+    s_dot_hand = float(_xz(v_hand) @ tangent)
+    s_pace = cfg.pace_mps * (t - cfg.start_s)
+    if s_pace > s_hand + cfg.lead_max_m:  # the person waits for the hand
+        s_target, s_dot_target = s_hand + cfg.lead_max_m, s_dot_hand
+    elif s_pace < s_hand + cfg.lead_min_m:  # the person follows the hand
+        s_target, s_dot_target = s_hand + cfg.lead_min_m, s_dot_hand
+    else:
+        s_target, s_dot_target = s_pace, cfg.pace_mps
+    if s_target >= path.length:  # the person stops at the path's end
+        s_target, s_dot_target = path.length, 0.0
+    pull = cfg.stiffness_N_per_m * (s_target - s_hand) + cfg.damping_Ns_per_m * (
+        s_dot_target - s_dot_hand
+    )
+    pull = min(max(pull, 0.0), cfg.force_cap_N)
+    chord = path.point(s_target) - path.point(s_hand)
+    norm = float(np.linalg.norm(chord))
+    direction = chord / norm if norm > 1e-9 else tangent
+    return scale * pull * np.array([direction[0], 0.0, direction[1]])
+
+
 class HumanWrenchSource(LeafSystem):
     """Outputs spatial_forces (for the plant's applied_spatial_force input)
     and hand_wrenches_W (12: [torque_l, force_l, torque_r, force_r]), the same
@@ -87,10 +174,14 @@ class HumanWrenchSource(LeafSystem):
         nx = plant.num_multibody_states(self._instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         prereq = {self.time_ticket()}
+        self._path = None
         if config.mode == "reactive":
             # Where the hands are at t = 0: the targets leave from there (the
-            # robot sits still until the pull starts).
-            self._start_index = self.DeclareDiscreteState(6)
+            # robot sits still until the pull starts); and the CoM height then,
+            # from which the path guide sees the robot rise.
+            if config.reactive.guide == "path":
+                self._path = Path(config.reactive.path_xz_m)
+            self._start_index = self.DeclareDiscreteState(7)
             self.DeclareInitializationDiscreteUpdateEvent(self._CaptureStart)
             prereq |= {self._state.ticket(), self.all_state_ticket()}
         # The scripted pulls are a function of time alone: the last time and
@@ -120,20 +211,31 @@ class HumanWrenchSource(LeafSystem):
         v = [f.CalcSpatialVelocity(c, world, world).translational() for f in self._frames]
         return p, v
 
+    def _com_height(self) -> float:
+        """The robot's CoM height in the context _hands last set. m."""
+        com = self._plant.CalcCenterOfMassPositionInWorld(self._context, [self._instance])
+        return float(com[2])
+
     def _CaptureStart(self, context: Context, discrete_state) -> None:
         p, _ = self._hands(context)
-        discrete_state.set_value(self._start_index, np.concatenate(p))
+        discrete_state.set_value(self._start_index, np.concatenate([*p, [self._com_height()]]))
 
     def _forces(self, context: Context) -> np.ndarray:
         """(2, 3) world forces on the left and right hand. N."""
         t = context.get_time()
         if self._cfg.mode == "scripted":
             return scripted_forces(self._cfg.pulls, t)
-        start = context.get_discrete_state(self._start_index).value().reshape(2, 3)
+        captured = context.get_discrete_state(self._start_index).value()
+        start = captured[:6].reshape(2, 3)
         r = self._cfg.reactive
         if not r.start_s < t < r.start_s + r.duration_s:
             return np.zeros((2, 3))  # no kinematics needed outside the pull
         p, v = self._hands(context)
+        if self._path is not None:
+            rise = self._com_height() - captured[6]
+            return np.array(
+                [path_force(r, self._path, t, p[i], v[i], start[i], rise) for i in range(2)]
+            )
         return np.array(
             [reactive_force(self._cfg.reactive, t, p[i], v[i], start[i]) for i in range(2)]
         )
