@@ -134,18 +134,23 @@ class ReactiveHumanConfig:
     # (~0.35 m forward, 0.4-0.5 m up). A first leg mostly up kept the robot in
     # state 2 at psi = t (the pull unloaded its feet). m.
     path_xz_m: list[list[float]] = field(default_factory=lambda: [[0.40, 0.30], [0.45, 0.70]])
+    # The path's corners rounded to this radius: a person's hands turn no
+    # sharp corner, and the hand's closest point on the path (so the pull)
+    # then moves continuously as the hand passes the corner's inside. m.
+    path_corner_radius_m: float = 0.2
     # A person's pace walking the hands: a stand-up of the order of 2 s. m/s.
     pace_mps: float = 0.3
     # The target's distance ahead of the hand along the path: at most
     # lead_max_m (no yank: the spring's pull stays under K lead_max), at least
     # lead_min_m (the person keeps pulling a hand that outruns the pace, with
-    # K lead_min = 22.5 N at most, within SPEC 3's 10-25 N). m.
+    # K lead_min: 22.5 N at 150 N/m, within SPEC 3's 10-25 N). m.
     lead_min_m: float = 0.15
     lead_max_m: float = 0.20
     # The pull fades linearly from full to zero while the CoM rises from the
-    # first to the second height above where it was at t = 0: the robot is up
-    # (seated 0.38 m; standing 0.53-0.58 m). m.
-    ease_com_rise_m: list[float] = field(default_factory=lambda: [0.10, 0.14])
+    # first to the second height above where it was at t = 0: from coming up
+    # to nearly up (seated 0.38 m; standing 0.53-0.58 m). The CoM rises at up
+    # to 0.5 m/s there: a band of 0.07 m lets go over ~0.15 s. m.
+    ease_com_rise_m: list[float] = field(default_factory=lambda: [0.07, 0.14])
 
 
 @dataclass
@@ -693,6 +698,7 @@ def _validate_path(r: ReactiveHumanConfig) -> None:
                 f"the one before ({previous}; the path starts at [0, 0])"
             )
         previous = point
+    _positive(f"{key}.path_corner_radius_m", r.path_corner_radius_m, allow_zero=True)
     _positive(f"{key}.pace_mps", r.pace_mps)
     _positive(f"{key}.lead_min_m", r.lead_min_m, allow_zero=True)
     if not r.lead_max_m >= r.lead_min_m:

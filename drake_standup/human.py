@@ -14,6 +14,8 @@ The wrench acts at the origin of the hand task frame (the hand's DH frame).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from pydrake.common.value import Value
 from pydrake.multibody.math import SpatialForce
@@ -66,12 +68,52 @@ def reactive_force(
     return scale * f
 
 
+# Largest turn of one segment of a rounded corner: a hand 0.1 m inside the
+# arc sees its closest point jump 2 (0.1 m) tan(0.5 deg) = 1.7 mm per vertex. rad.
+ARC_STEP_RAD = math.radians(1.0)
+
+
+def _round_corners(points: np.ndarray, radius: float) -> np.ndarray:
+    """points with each interior corner replaced by a circular arc of radius
+    (less where a leg is too short: the arc takes at most half of each leg),
+    as segments turning ARC_STEP_RAD at most."""
+    if radius <= 0.0 or len(points) < 3:
+        return points
+    out = [points[0]]
+    for before, corner, after in zip(points[:-2], points[1:-1], points[2:]):
+        a, b = corner - before, after - corner
+        la, lb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+        a, b = a / la, b / lb
+        turn = math.acos(min(1.0, max(-1.0, float(a @ b))))
+        if turn < 1e-6 or turn > math.pi - 1e-6:
+            out.append(corner)
+            continue
+        cut = min(radius * math.tan(turn / 2), 0.5 * la, 0.5 * lb)
+        r = cut / math.tan(turn / 2)
+        centre = corner + (r / math.cos(turn / 2)) * (b - a) / float(np.linalg.norm(b - a))
+        u0, u1 = corner - cut * a - centre, corner + cut * b - centre
+        phi0 = math.atan2(u0[1], u0[0])
+        sweep = (math.atan2(u1[1], u1[0]) - phi0 + math.pi) % (2 * math.pi) - math.pi
+        n = max(1, math.ceil(abs(sweep) / ARC_STEP_RAD))
+        for k in range(n + 1):
+            phi = phi0 + sweep * k / n
+            out.append(centre + r * np.array([math.cos(phi), math.sin(phi)]))
+    out.append(points[-1])
+    return np.array(out)
+
+
 class Path:
     """A polyline in the sagittal (x, z) plane from [0, 0] through waypoints,
-    parametrised by arc length s."""
+    its corners rounded to corner_radius_m, parametrised by arc length s.
 
-    def __init__(self, waypoints_xz: list[list[float]]):
-        self.points = np.vstack([np.zeros(2), np.asarray(waypoints_xz, dtype=float)])
+    Rounded, the hand's closest point moves continuously as the hand passes
+    inside a corner (at a sharp corner it jumps from one leg to the next, and
+    the pull's direction with it) as long as the hand stays closer to the path
+    than the radius."""
+
+    def __init__(self, waypoints_xz: list[list[float]], corner_radius_m: float = 0.0):
+        sharp = np.vstack([np.zeros(2), np.asarray(waypoints_xz, dtype=float)])
+        self.points = _round_corners(sharp, corner_radius_m)
         self.lengths = np.linalg.norm(np.diff(self.points, axis=0), axis=1)
         self.s_start = np.concatenate([[0.0], np.cumsum(self.lengths)])
         self.length = float(self.s_start[-1])
@@ -84,14 +126,13 @@ class Path:
         return self.points[i] + (s - self.s_start[i]) * self.tangents[i]
 
     def project(self, p: np.ndarray) -> tuple[float, np.ndarray]:
-        """(s, unit tangent) of the path's point closest to p (x, z)."""
-        best = (np.inf, 0.0, self.tangents[0])
-        for i, (a, t, length) in enumerate(zip(self.points, self.tangents, self.lengths)):
-            u = min(max(float((p - a) @ t), 0.0), length)
-            d = float(np.linalg.norm(p - (a + u * t)))
-            if d < best[0] - 1e-12:
-                best = (d, self.s_start[i] + u, t)
-        return best[1], best[2]
+        """(s, unit tangent) of the path's point closest to p (x, z); of two
+        equally close, the first along the path."""
+        a = self.points[:-1]
+        u = np.clip(np.einsum("ij,ij->i", p - a, self.tangents), 0.0, self.lengths)
+        d = np.linalg.norm(p - (a + u[:, None] * self.tangents), axis=1)
+        i = int(np.argmin(d))
+        return float(self.s_start[i] + u[i]), self.tangents[i]
 
 
 def _xz(v: np.ndarray) -> np.ndarray:
@@ -180,7 +221,8 @@ class HumanWrenchSource(LeafSystem):
             # robot sits still until the pull starts); and the CoM height then,
             # from which the path guide sees the robot rise.
             if config.reactive.guide == "path":
-                self._path = Path(config.reactive.path_xz_m)
+                r = config.reactive
+                self._path = Path(r.path_xz_m, r.path_corner_radius_m)
             self._start_index = self.DeclareDiscreteState(7)
             self.DeclareInitializationDiscreteUpdateEvent(self._CaptureStart)
             prereq |= {self._state.ticket(), self.all_state_ticket()}

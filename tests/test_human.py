@@ -5,6 +5,8 @@ and eases off (each against numbers written out by hand)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from pydrake.math import RigidTransform
@@ -184,6 +186,25 @@ def test_path_arc_length_and_closest_point():
     np.testing.assert_allclose(tangent, [0.6, 0.8])
 
 
+def test_rounded_corner_arc_length_and_continuous_progress():
+    """A right-angle corner rounded to 0.2 m: the path is 2 - 2 r + pi r / 2
+    long (its 1-degree chords 0.001% shorter), and the closest point of a hand
+    passing the corner's inside, 0.1 m from the path, moves continuously: by
+    under 4 mm per mm of the hand (r / (r - 0.1) = 2 mm on the arc, plus at
+    most a vertex's 1.7 mm) where at the sharp corner it jumps by 0.2 m."""
+    r = 0.2
+    path = Path([[1.0, 0.0], [1.0, 1.0]], corner_radius_m=r)
+    assert path.length == pytest.approx(2.0 - 2.0 * r + math.pi * r / 2, rel=2e-5)
+    np.testing.assert_allclose(path.point(0.5), [0.5, 0.0], atol=1e-12)
+    np.testing.assert_allclose(path.point(path.length - 0.5), [1.0, 0.5], atol=1e-12)
+    hand_z = np.linspace(0.05, 0.3, 251)  # along x = 0.9, past the corner, 1 mm apart
+    s = np.array([path.project(np.array([0.9, z]))[0] for z in hand_z])
+    assert np.all(np.diff(s) >= 0.0) and np.diff(s).max() < 0.004
+    sharp = Path([[1.0, 0.0], [1.0, 1.0]])
+    s = np.array([sharp.project(np.array([0.9, z]))[0] for z in hand_z])
+    assert np.diff(s).max() > 0.15  # the sharp corner's jump, for contrast
+
+
 def test_path_target_travels_at_the_pace():
     """Hand still at its start: the target is pace (t - start) along the path,
     moving at the pace, so F = K pace (t - start) + D pace along the path."""
@@ -289,6 +310,7 @@ def test_reactive_scenarios_load():
         ("path_xz_m: [[0.3, 0.2, 0.1]]", "human.reactive.path_xz_m[0]"),
         ("path_xz_m: [[0.3, 0.2], [0.3, 0.2]]", "human.reactive.path_xz_m[1]"),
         ("pace_mps: 0.0", "human.reactive.pace_mps"),
+        ("path_corner_radius_m: -0.1", "human.reactive.path_corner_radius_m"),
         ("lead_min_m: -0.1", "human.reactive.lead_min_m"),
         ("{lead_min_m: 0.2, lead_max_m: 0.1}", "human.reactive.lead_max_m"),
         ("ease_com_rise_m: [0.14, 0.10]", "human.reactive.ease_com_rise_m"),
