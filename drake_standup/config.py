@@ -100,13 +100,22 @@ class Pull:
 
 @dataclass
 class ReactiveHumanConfig:
-    """A helper who pulls each hand toward a target moving up and forward.
+    """A helper who guides each hand; the pull fades in and out over ramp_s
+    (SPEC 3: the authors' human pulled 10-25 N per hand).
 
-    F = sat(K (p_target - p_hand) - D v_hand, force_cap_N), the target leaving
-    the hand's position at start_s with velocity target_velocity_mps for at most
-    travel_m; the pull fades in and out over ramp_s (SPEC 3: 10-25 N per hand).
+    guide: velocity (the first model, the default so that older scenario files
+    keep their meaning): F = sat(K (p_target - p_hand) - D v_hand, force_cap_N),
+    the target leaving the hand's position at start_s with velocity
+    target_velocity_mps for at most travel_m.
+    guide: path (human.py, path_force): a person walking each hand along a path
+    in the sagittal plane (path_xz_m from where the hand was) at pace_mps, never
+    more than lead_max_m ahead of the hand, never less than lead_min_m while the
+    path goes on; the pull acts along the path only (never backwards, never
+    sideways), is capped, and eases off as the hand reaches the path's end or
+    the robot's CoM has risen by ease_com_rise_m.
     """
 
+    guide: str = "velocity"
     start_s: float = 3.0
     duration_s: float = 8.0
     ramp_s: float = 0.5
@@ -115,8 +124,33 @@ class ReactiveHumanConfig:
     damping_Ns_per_m: float = 20.0
     # Per hand; the authors' human pulled 10-25 N (SPEC 3). N.
     force_cap_N: float = 20.0
+    # guide: velocity.
     target_velocity_mps: list[float] = field(default_factory=lambda: [0.10, 0.0, 0.10])
     travel_m: float = 0.35
+    # guide: path. Waypoints [forward, up] from the hand's position at t = 0,
+    # the start itself implied: forward and a little up (37 deg) past where the
+    # robot's hands are while it leans forward (states 2-3: ~0.3 m forward,
+    # 0.2-0.3 m up), then nearly straight up, beyond where they are standing
+    # (~0.35 m forward, 0.4-0.5 m up). A first leg mostly up kept the robot in
+    # state 2 at psi = t (the pull unloaded its feet). m.
+    path_xz_m: list[list[float]] = field(default_factory=lambda: [[0.40, 0.30], [0.45, 0.70]])
+    # The path's corners rounded to this radius: a person's hands turn no
+    # sharp corner, and the hand's closest point on the path (so the pull)
+    # then moves continuously as the hand passes the corner's inside. m.
+    path_corner_radius_m: float = 0.2
+    # A person's pace walking the hands: a stand-up of the order of 2 s. m/s.
+    pace_mps: float = 0.3
+    # The target's distance ahead of the hand along the path: at most
+    # lead_max_m (no yank: the spring's pull stays under K lead_max), at least
+    # lead_min_m (the person keeps pulling a hand that outruns the pace, with
+    # K lead_min: 22.5 N at 150 N/m, within SPEC 3's 10-25 N). m.
+    lead_min_m: float = 0.15
+    lead_max_m: float = 0.20
+    # The pull fades linearly from full to zero while the CoM rises from the
+    # first to the second height above where it was at t = 0: from coming up
+    # to nearly up (seated 0.38 m; standing 0.53-0.58 m). The CoM rises at up
+    # to 0.5 m/s there: a band of 0.07 m lets go over ~0.15 s. m.
+    ease_com_rise_m: list[float] = field(default_factory=lambda: [0.07, 0.14])
 
 
 @dataclass
@@ -651,11 +685,44 @@ def _validate_human(human: HumanConfig) -> None:
             )
         _length(f"{key}.force_N", pull.force_N, 3)
     r = human.reactive
+    _choice("human.reactive.guide", r.guide, ("velocity", "path"))
     for name in ("start_s", "ramp_s", "stiffness_N_per_m", "damping_Ns_per_m", "travel_m"):
         _positive(f"human.reactive.{name}", getattr(r, name), allow_zero=True)
     _positive("human.reactive.duration_s", r.duration_s)
     _positive("human.reactive.force_cap_N", r.force_cap_N)
     _length("human.reactive.target_velocity_mps", r.target_velocity_mps, 3)
+    _validate_path(r)
+
+
+def _validate_path(r: ReactiveHumanConfig) -> None:
+    key = "human.reactive"
+    if not r.path_xz_m:
+        raise ScenarioError(
+            f"{key}.path_xz_m: empty; accepted: a list of [forward, up] waypoints, m"
+        )
+    previous = [0.0, 0.0]
+    for i, point in enumerate(r.path_xz_m):
+        _length(f"{key}.path_xz_m[{i}]", point, 2)
+        if math.dist(point, previous) < 1e-3:
+            raise ScenarioError(
+                f"{key}.path_xz_m[{i}]: {point}; accepted: a waypoint at least 1 mm from "
+                f"the one before ({previous}; the path starts at [0, 0])"
+            )
+        previous = point
+    _positive(f"{key}.path_corner_radius_m", r.path_corner_radius_m, allow_zero=True)
+    _positive(f"{key}.pace_mps", r.pace_mps)
+    _positive(f"{key}.lead_min_m", r.lead_min_m, allow_zero=True)
+    if not r.lead_max_m >= r.lead_min_m:
+        raise ScenarioError(
+            f"{key}.lead_max_m: {r.lead_max_m}; accepted: a number >= lead_min_m ({r.lead_min_m})"
+        )
+    _length(f"{key}.ease_com_rise_m", r.ease_com_rise_m, 2)
+    low, high = r.ease_com_rise_m
+    if not 0.0 <= low < high:
+        raise ScenarioError(
+            f"{key}.ease_com_rise_m: {r.ease_com_rise_m}; accepted: [start, end] with "
+            "0 <= start < end, m"
+        )
 
 
 def _validate_advancement(adv: AdvancementConfig) -> None:

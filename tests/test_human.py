@@ -1,7 +1,11 @@
 """The human: scripted pulls reach the plant exactly; physics agrees; the
-reactive helper pulls toward its target within its force cap."""
+reactive helper pulls toward its target within its force cap; the path guide
+walks the hand at its pace, never yanks, never pulls backwards or sideways,
+and eases off (each against numbers written out by hand)."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import pytest
@@ -11,9 +15,18 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from drake_standup.config import HumanConfig, Pull, ReactiveHumanConfig, Scenario
+from drake_standup.config import (
+    SCENARIO_DIR,
+    HumanConfig,
+    Pull,
+    ReactiveHumanConfig,
+    Scenario,
+    ScenarioError,
+    load_scenario,
+    parse_scenario,
+)
 from drake_standup.diagram import build_diagram
-from drake_standup.human import HumanWrenchSource, reactive_force, trapezoid
+from drake_standup.human import HumanWrenchSource, Path, path_force, reactive_force, trapezoid
 from drake_standup.robot import ContactModel, add_icub
 
 PULLS = [
@@ -123,3 +136,193 @@ def test_reactive_human_pulls_toward_target_within_cap():
     # Hand moving toward the target: damping reduces the pull.
     f_moving = reactive_force(cfg, 1.5, start, 0.1 * direction, start)
     assert np.linalg.norm(f_moving) < cfg.stiffness_N_per_m * travel
+
+
+# --- guide: path ---------------------------------------------------------------
+# A straight path 1 m long along (0.6, 0.8) in (forward, up): a 3-4-5 triangle,
+# so every number below is written out by hand.
+START = np.array([0.24, 0.11, 0.31])
+DIR = np.array([0.6, 0.0, 0.8])
+
+
+def _path_cfg(**kw) -> ReactiveHumanConfig:
+    values = dict(
+        guide="path",
+        start_s=1.0,
+        duration_s=10.0,
+        ramp_s=0.5,
+        stiffness_N_per_m=100.0,
+        damping_Ns_per_m=10.0,
+        force_cap_N=100.0,
+        path_xz_m=[[0.6, 0.8]],
+        pace_mps=0.2,
+        lead_min_m=0.0,
+        lead_max_m=1.0,
+        ease_com_rise_m=[0.10, 0.14],
+    )
+    values.update(kw)
+    return ReactiveHumanConfig(**values)
+
+
+def _pull(cfg, t, s_hand=0.0, v_along=0.0, rise=0.0, sideways=0.0, v_sideways=0.0):
+    """The force on a hand s_hand along the straight path, moving v_along."""
+    side = np.array([0.0, 1.0, 0.0])
+    p = START + s_hand * DIR + sideways * side
+    v = v_along * DIR + v_sideways * side
+    return path_force(cfg, Path(cfg.path_xz_m), t, p, v, START, rise)
+
+
+def test_path_arc_length_and_closest_point():
+    path = Path([[0.3, 0.4], [0.3, 1.4]])  # 0.5 m up-forward, then 1 m straight up
+    assert path.length == pytest.approx(1.5)
+    np.testing.assert_allclose(path.point(0.25), [0.15, 0.2])
+    np.testing.assert_allclose(path.point(1.0), [0.3, 0.9])
+    np.testing.assert_allclose(path.point(9.0), [0.3, 1.4])  # clamped to the end
+    s, tangent = path.project(np.array([0.5, 1.0]))  # 0.2 m in front of the upright leg
+    assert s == pytest.approx(0.5 + 0.6)
+    np.testing.assert_allclose(tangent, [0.0, 1.0])
+    s, tangent = path.project(np.array([-0.1, -0.1]))  # behind the start
+    assert s == 0.0
+    np.testing.assert_allclose(tangent, [0.6, 0.8])
+
+
+def test_rounded_corner_arc_length_and_continuous_progress():
+    """A right-angle corner rounded to 0.2 m: the path is 2 - 2 r + pi r / 2
+    long (its 1-degree chords 0.001% shorter), and the closest point of a hand
+    passing the corner's inside, 0.1 m from the path, moves continuously: by
+    under 4 mm per mm of the hand (r / (r - 0.1) = 2 mm on the arc, plus at
+    most a vertex's 1.7 mm) where at the sharp corner it jumps by 0.2 m."""
+    r = 0.2
+    path = Path([[1.0, 0.0], [1.0, 1.0]], corner_radius_m=r)
+    assert path.length == pytest.approx(2.0 - 2.0 * r + math.pi * r / 2, rel=2e-5)
+    np.testing.assert_allclose(path.point(0.5), [0.5, 0.0], atol=1e-12)
+    np.testing.assert_allclose(path.point(path.length - 0.5), [1.0, 0.5], atol=1e-12)
+    hand_z = np.linspace(0.05, 0.3, 251)  # along x = 0.9, past the corner, 1 mm apart
+    s = np.array([path.project(np.array([0.9, z]))[0] for z in hand_z])
+    assert np.all(np.diff(s) >= 0.0) and np.diff(s).max() < 0.004
+    sharp = Path([[1.0, 0.0], [1.0, 1.0]])
+    s = np.array([sharp.project(np.array([0.9, z]))[0] for z in hand_z])
+    assert np.diff(s).max() > 0.15  # the sharp corner's jump, for contrast
+
+
+def test_path_target_travels_at_the_pace():
+    """Hand still at its start: the target is pace (t - start) along the path,
+    moving at the pace, so F = K pace (t - start) + D pace along the path."""
+    cfg = _path_cfg()
+    for elapsed in (0.5, 1.5, 2.5):
+        f = _pull(cfg, 1.0 + elapsed)
+        expected = 100.0 * 0.2 * elapsed + 10.0 * 0.2
+        np.testing.assert_allclose(f, expected * DIR, atol=1e-12)
+    # Nothing before the start nor after the pull's end.
+    assert not _pull(cfg, 0.9).any()
+    assert not _pull(cfg, 11.0).any()
+    # On the ramp: scaled by it (0.25 s into 0.5 s: one half).
+    np.testing.assert_allclose(_pull(cfg, 1.25), 0.5 * (100 * 0.05 + 2.0) * DIR, atol=1e-12)
+
+
+def test_path_never_more_than_lead_max_ahead_no_yank():
+    """The person waits for a hand left behind: the target is lead_max ahead of
+    it and moves with it, however far the pace has gone."""
+    cfg = _path_cfg(lead_max_m=0.25)
+    for v_along in (0.0, 0.3):
+        f = _pull(cfg, 5.0, s_hand=0.1, v_along=v_along)  # pace: 0.8 m
+        np.testing.assert_allclose(f, 100.0 * 0.25 * DIR, atol=1e-12)
+
+
+def test_path_follows_a_hand_that_outruns_the_pace():
+    """A hand ahead of the pace keeps lead_min of pull, not more, not less."""
+    cfg = _path_cfg(lead_min_m=0.1)
+    f = _pull(cfg, 2.0, s_hand=0.5, v_along=0.8)  # pace: 0.2 m
+    np.testing.assert_allclose(f, 100.0 * 0.1 * DIR, atol=1e-12)
+
+
+def test_path_never_pulls_backwards():
+    """A hand moving faster than the pace toward the target: the damping
+    would pull it back; the person lets go instead (zero, never negative)."""
+    cfg = _path_cfg()
+    f = _pull(cfg, 2.0, s_hand=0.15, v_along=2.0)  # K 0.05 + D (0.2 - 2) < 0
+    assert not f.any()
+
+
+def test_path_force_cap():
+    cfg = _path_cfg(force_cap_N=25.0)
+    f = _pull(cfg, 5.0)  # K 0.8 + D 0.2 = 82 N uncapped
+    assert np.linalg.norm(f) == pytest.approx(25.0)
+    np.testing.assert_allclose(f / 25.0, DIR, atol=1e-12)
+
+
+def test_path_no_sideways_force():
+    """Out of the sagittal plane, and moving sideways: no sideways force, and
+    the same pull as on the path."""
+    cfg = _path_cfg()
+    on_path = _pull(cfg, 2.0, s_hand=0.1)
+    aside = _pull(cfg, 2.0, s_hand=0.1, sideways=0.12, v_sideways=0.5)
+    assert aside[1] == 0.0
+    np.testing.assert_allclose(aside, on_path, atol=1e-12)
+
+
+def test_path_pull_turns_through_a_corner_along_the_path():
+    """Hand 0.1 m before a corner, target 0.1 m after it: the pull points from
+    the hand's point on the path to the target's point."""
+    cfg = _path_cfg(path_xz_m=[[0.4, 0.3], [0.4, 1.3]], lead_min_m=0.2, lead_max_m=0.2)
+    path = Path(cfg.path_xz_m)
+    p = START + np.array([0.32, 0.0, 0.24])  # 0.4 m along the first leg (0.8, 0.6)
+    f = path_force(cfg, path, 2.0, p, np.zeros(3), START, 0.0)
+    chord = np.array([0.4, 0.4]) - np.array([0.32, 0.24])
+    direction = chord / np.linalg.norm(chord)
+    np.testing.assert_allclose(f, 100.0 * 0.2 * np.array([direction[0], 0.0, direction[1]]))
+    assert f[0] > 0.0 and f[2] > 0.0
+
+
+def test_path_eases_off_at_the_end_and_once_the_robot_is_up():
+    cfg = _path_cfg(lead_min_m=0.1)
+    # At the path's end the target stops there: no pull on a hand that is there.
+    assert not _pull(cfg, 9.0, s_hand=1.0).any()
+    # 0.04 m before it: K 0.04 toward the end, no more (the target has stopped).
+    np.testing.assert_allclose(_pull(cfg, 9.0, s_hand=0.96), 4.0 * DIR, atol=1e-12)
+    # The CoM's rise: full pull below 0.10 m, half at 0.12 m, none from 0.14 m.
+    full = _pull(cfg, 2.0, rise=0.05)
+    np.testing.assert_allclose(_pull(cfg, 2.0, rise=0.12), 0.5 * full, atol=1e-12)
+    assert not _pull(cfg, 2.0, rise=0.14).any()
+    assert not _pull(cfg, 2.0, rise=0.3).any()
+
+
+def test_reactive_scenarios_load():
+    """The shipped reactive scenario uses the path guide; a file written before
+    it (mode: reactive and the first keys only) loads with guide: velocity."""
+    shipped = load_scenario(SCENARIO_DIR / "reactive.yaml").human
+    assert shipped.mode == "reactive" and shipped.reactive.guide == "path"
+    assert shipped.reactive.force_cap_N <= 25.0  # SPEC 3: 10-25 N per hand
+    old = parse_scenario(
+        "human:\n  mode: reactive\n  reactive:\n    force_cap_N: 15.0\n"
+        "    target_velocity_mps: [0.1, 0.0, 0.2]\n",
+        "old",
+    ).human.reactive
+    assert old.guide == "velocity" and old.force_cap_N == 15.0
+    assert old.path_xz_m == ReactiveHumanConfig().path_xz_m
+
+
+@pytest.mark.parametrize(
+    "body, key",
+    [
+        ("guide: spring", "human.reactive.guide"),
+        ("path_xz_m: []", "human.reactive.path_xz_m"),
+        ("path_xz_m: [[0.3, 0.2, 0.1]]", "human.reactive.path_xz_m[0]"),
+        ("path_xz_m: [[0.3, 0.2], [0.3, 0.2]]", "human.reactive.path_xz_m[1]"),
+        ("pace_mps: 0.0", "human.reactive.pace_mps"),
+        ("path_corner_radius_m: -0.1", "human.reactive.path_corner_radius_m"),
+        ("lead_min_m: -0.1", "human.reactive.lead_min_m"),
+        ("{lead_min_m: 0.2, lead_max_m: 0.1}", "human.reactive.lead_max_m"),
+        ("ease_com_rise_m: [0.14, 0.10]", "human.reactive.ease_com_rise_m"),
+        ("ease_com_rise_m: [0.1]", "human.reactive.ease_com_rise_m"),
+    ],
+)
+def test_bad_path_keys_are_one_line_errors_naming_the_key(body, key):
+    if body.startswith("{"):
+        text = f"human:\n  mode: reactive\n  reactive: {body}\n"
+    else:
+        text = f"human:\n  mode: reactive\n  reactive:\n    {body}\n"
+    with pytest.raises(ScenarioError) as err:
+        parse_scenario(text, "test")
+    message = str(err.value)
+    assert "\n" not in message and message.startswith(key) and "accepted" in message

@@ -59,6 +59,35 @@ def test_assisted_stands_up_sooner(assisted, unassisted):
     assert m["standup_time_s"] < m["standup_time_s_without_advancement"]
 
 
+@pytest.fixture(scope="module")
+def reactive(tmp_path_factory):
+    out = tmp_path_factory.mktemp("reactive")
+    scenario, metrics = _run("reactive", out, baseline=True)
+    return scenario, metrics, load_signals(out / "signals.npz")
+
+
+def test_reactive_helper_stands_up_sooner_and_lets_go(reactive, unassisted):
+    """Issue 12: the person guiding the hands stands the robot up at least 15%
+    sooner than alone; psi_dot within [1, upper], psi = t wherever nobody
+    pulls; the pull within the cap, never sideways nor backwards, and none on
+    the standing robot; the same helper at psi = t stands the robot up too."""
+    scenario, m, sig = reactive
+    _, u = unassisted
+    assert m["success"], m["failure_reason"]
+    assert m["qp_failures"] == 0
+    assert m["standup_time_s"] <= 0.85 * u["standup_time_s"]
+    assert 1.0 <= m["psi_dot_min"] and m["psi_dot_max"] <= scenario.advancement.psi_dot_upper
+    assert m["standup_time_s_without_advancement"] is not None  # psi = t stood up too
+    forces = sig["hand_wrenches_W"].reshape(-1, 2, 6)[:, :, 3:]
+    assert np.linalg.norm(forces, axis=2).max() <= scenario.human.reactive.force_cap_N + 1e-9
+    assert not forces[:, :, 1].any()
+    assert forces[:, :, 0].min() >= 0.0 and forces[:, :, 2].min() >= 0.0
+    nobody = ~forces.any(axis=(1, 2))
+    assert np.all(sig["psi_dot"][nobody] == 1.0)
+    standing = sig["time_s"] >= sig["time_s"][np.argmax(sig["state"] >= 2)] + m["standup_time_s"]
+    assert np.all(nobody[standing])
+
+
 @pytest.mark.parametrize("name", ["hindering", "lateral"])
 def test_unhelpful_pulls_never_advance_and_end_cleanly(name):
     scenario, m = _run(name)
