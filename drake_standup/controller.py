@@ -12,7 +12,7 @@ Ports
     contact_plan     (3)        [standup_state 1-4, seat_scale 0-1, feet_scale 0-1]
     hand_wrenches_W  (12)       [tau_l, f_l, tau_r, f_r], world, at the hand frames' origins
     -> actuation     (nu)       joint torques, actuator order, N m (zero-order held)
-    -> diagnostics   (10)       see DIAGNOSTICS
+    -> diagnostics   (13)       see DIAGNOSTICS
 
 Contacts: the seat (a 6-D contact on root_link under the buttocks), both thighs (point
 forces on the thigh pads) and both soles (6-D). The seat and soles are held by the QP
@@ -52,6 +52,7 @@ from drake_standup.control.tasks import (
     JointLimitBounds,
     MomentumTask,
     PostureTask,
+    StancePostureTask,
 )
 from drake_standup.control.terms import BASE_BODY, RobotKinematics, RobotTerms
 from drake_standup.robot import Robot, actuated_joints
@@ -230,11 +231,22 @@ class ControllerConfig:
                 ("hip_pitch", 10.0),
                 ("knee", 10.0),
                 ("ankle_pitch", 10.0),
-                ("shoulder_pitch", 10.0),
-                ("shoulder_roll", 10.0),
-                ("shoulder_yaw", 10.0),
-                ("elbow", 10.0),
+                ("shoulder_pitch", 3.0),
+                ("shoulder_roll", 3.0),
+                ("shoulder_yaw", 3.0),
+                ("elbow", 3.0),
             )
+        }
+    )
+    # Posture weights that grow with the stance factor (0 -> 1 over the end of the rise):
+    # the arms, which carry the pull, held once standing (at 3 a 25 N per hand upward
+    # pull swung the shoulders through their range in 0.2 s; held from the start of
+    # state 4 they could not help balance the rise: 1.6 kN sole spikes, measured).
+    stance_arm_weight_by_joint: dict[str, float] = field(
+        default_factory=lambda: {
+            f"{side}_{joint}": 7.0
+            for side in "lr"
+            for joint in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
         }
     )
     # QP solver: daqp (measured fastest, exact equalities), or Drake's osqp / clarabel.
@@ -343,6 +355,9 @@ class WholeBodyController(LeafSystem):
         "l_sole_fz_N",  # commanded normal force, left sole
         "r_sole_fz_N",  # commanded normal force, right sole
         "helpful_force_N",  # ||f_par||: the part of the pull the controller lets act
+        "joint_limit_slack",  # largest slack of the soft joint-limit bounds, rad/s^2
+        "lean_x_m",  # the CoM target's lean against the pull, x
+        "lean_y_m",  # ... and y, m
     )
     # Columns of timing_s().
     TIMING = ("inputs_s", "kinematics_s", "assembly_s", "solve_s", "total_s")
@@ -380,11 +395,9 @@ class WholeBodyController(LeafSystem):
             "posture_weight_by_joint",
             config.posture_weight,
         )
-        self._stance_weights = joint_values(
-            joints.names,
-            config.stance_posture_weight_by_joint,
-            "stance_posture_weight_by_joint",
-            0.0,
+        self._stance_weights, self._stance_arm_weights = (
+            joint_values(joints.names, getattr(config, key), key, 0.0)
+            for key in ("stance_posture_weight_by_joint", "stance_arm_weight_by_joint")
         )
         self._joint_limits = JointLimitBounds(
             joints.q_indices, joints.v_indices, joints.q_min, joints.q_max,
@@ -526,6 +539,16 @@ class WholeBodyController(LeafSystem):
                     name="stance_posture",
                     active_states=frozenset({4}),
                 ),
+                StancePostureTask(
+                    layout,
+                    self._joints.q_indices,
+                    self._joints.v_indices,
+                    self._stance_arm_weights,
+                    config.posture_kp_per_s2,
+                    config.posture_damping_ratio,
+                    name="stance_arms",
+                    active_states=frozenset({4}),
+                ),
                 BaseOrientationTask(
                     layout,
                     config.base_orientation_weight,
@@ -598,8 +621,10 @@ class WholeBodyController(LeafSystem):
         diagnostics = np.empty(len(self.DIAGNOSTICS))
         f_par = tick.helpful_force_W
         diagnostics[:4] = float(solution.ok), failures, solution.solve_s, total_s
-        diagnostics[4:-1] = tick.normal_forces_N if solution.ok else np.nan
-        diagnostics[-1] = math.sqrt(float(f_par @ f_par))
+        diagnostics[4:9] = tick.normal_forces_N if solution.ok else np.nan
+        diagnostics[9] = math.sqrt(float(f_par @ f_par))
+        diagnostics[10] = float(np.abs(solution.slack).max()) if solution.slack.size else 0.0
+        diagnostics[11:13] = tick.lean_W[:2]
         discrete_state.set_value(self._diagnostics, diagnostics)
         self._timing.append(
             (tick.inputs_s, tick.kinematics_s, tick.assembly_s, solution.solve_s, total_s)

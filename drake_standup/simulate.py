@@ -423,6 +423,9 @@ def make_signals(built: StandupDiagram, root_context) -> dict[str, np.ndarray]:
         diagnostics = rows("controller_diagnostics")
         signals["qp_ok"] = diagnostics[:, 0] > 0.5
         signals["qp_failures"] = diagnostics[:, 1].astype(np.int64)
+        if diagnostics.shape[1] >= 13:
+            signals["joint_limit_slack"] = diagnostics[:, 10]
+            signals["com_lean_W"] = np.c_[diagnostics[:, 11:13], np.zeros(len(t))]
     if "push_force_W" in logs:
         signals["push_force_W"] = rows("push_force_W")
     return signals
@@ -451,6 +454,14 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
     metrics.update(outputs.standup_metrics(signals, metrics["state_entry_times_s"]))
     if "qp_failures" in signals:
         metrics["qp_failures"] = int(signals["qp_failures"][-1]) if len(signals["time_s"]) else 0
+    if "joint_limit_slack" in signals and len(signals["time_s"]):
+        slack = signals["joint_limit_slack"]
+        metrics["joint_limit_slack_peak"] = float(slack.max())
+        metrics["joint_limit_slack_integral"] = float(
+            np.sum(slack) * (signals["time_s"][1] - signals["time_s"][0])
+            if len(slack) > 1
+            else 0.0
+        )
     torques = signals["joint_torques_Nm"]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
     result.metrics = metrics

@@ -5,6 +5,8 @@ own: where it is active the solution meets it, where it is not the solution is t
 without it, bit for bit.
 """
 
+import functools
+
 import numpy as np
 import pytest
 from pydrake.systems.framework import DiagramBuilder
@@ -48,12 +50,18 @@ def _references(standup_state: int) -> TaskReferences:
         helpful_force_W=np.zeros(3),
         lean_W=np.zeros(3),
         vertical_weight_scale=1.0,
+        stance=0.0,
         next_posture=None,
     )
 
 
 @pytest.fixture(scope="module")
 def seated():
+    return seated_state()
+
+
+@functools.cache
+def seated_state():
     """The default scenario's plant, its seated state's terms for every contact, and
     what WholeBodyQp needs besides its tasks."""
     scenario = Scenario()
@@ -75,7 +83,18 @@ def seated():
     return plant, specs, terms, k
 
 
-def _qp(plant, specs, task_states):
+class _FixedBounds:
+    """Acceleration bounds that do not depend on the state."""
+
+    def __init__(self, v_indices, vdot_min, vdot_max):
+        self.v_indices = np.asarray(v_indices)
+        self._bounds = np.asarray(vdot_min, float), np.asarray(vdot_max, float)
+
+    def calc(self, terms):
+        return self._bounds
+
+
+def _qp(plant, specs, task_states, **bounds):
     """A QP over all contacts with the config's regularisation and, unless task_states is
     None, a _JointAcceleration task active in those states."""
     config = ControllerConfig()
@@ -89,6 +108,7 @@ def _qp(plant, specs, task_states):
         wrench_weight=config.wrench_weight,
         acceleration_weight=config.acceleration_weight,
         tasks=tasks,
+        **bounds,
     )
 
 
@@ -139,3 +159,55 @@ def test_static_lean_is_bounded_and_zero_without_a_pull():
     np.testing.assert_allclose(big, [-0.08, 0.08, 0.0])
     # A pull that lifts the robot off its feet: no static answer, no lean.
     assert not static_lean(np.r_[0.0, 5.0, 0.0, 10.0, 0.0, 400.0], 0.57, 324.0, 0.08).any()
+
+
+def test_soft_bounds_that_hold_at_the_optimum_change_nothing(seated):
+    plant, specs, terms, k = seated
+    nc = len(specs)
+    commands = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    free = _qp(plant, specs, (k, (2,))).solve(terms, _references(2), commands)
+    loose = _FixedBounds([k], [-100.0], [100.0])
+    bounded = _qp(plant, specs, (k, (2,)), soft_bounds=loose, soft_bound_weight=1e3).solve(
+        terms, _references(2), commands
+    )
+    assert free.ok and bounded.ok
+    # The same optimum, to the active-set solver's round-off on a larger program.
+    np.testing.assert_allclose(bounded.vdot, free.vdot, atol=1e-6)
+    assert bounded.slack.shape == (1,) and abs(bounded.slack[0]) < 1e-9
+
+
+@pytest.mark.parametrize("weight", [1e3, 1e4, 1e5])
+def test_soft_bound_against_a_task_meets_it_where_the_weights_say(weight):
+    """The task asks vdot_k = 2 (weight w_t), the bound vdot_k <= -1 with slack weight w_s:
+    min w_t (v - 2)^2 + w_s s^2, s = v + 1, gives v = (2 w_t - w_s) / (w_t + w_s), the
+    analytic optimum (to the regularisation's 1e-6 relative)."""
+    plant, specs, terms, k = seated_state()
+    nc = len(specs)
+    commands = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    bounds = _FixedBounds([k], [-100.0], [-1.0])
+    solution = _qp(plant, specs, (k, (2,)), soft_bounds=bounds, soft_bound_weight=weight).solve(
+        terms, _references(2), commands
+    )
+    w_t = 1.0e4  # _JointAcceleration's weight
+    v = (TARGET_RAD_PER_S2 * w_t - weight) / (w_t + weight)
+    assert solution.ok
+    assert solution.vdot[k] == pytest.approx(v, rel=1e-3, abs=1e-3)
+    assert solution.slack[0] == pytest.approx(v + 1.0, rel=1e-3, abs=1e-3)
+
+
+def test_soft_bounds_keep_an_impossible_bound_feasible(seated):
+    """Seated, the held seat and soles pin the knees: vdot_knee >= 5 rad/s^2 is impossible.
+    As a hard bound the program is infeasible; as a soft one it solves, the knee does not
+    move and the slack takes the whole 5 rad/s^2."""
+    plant, specs, terms, _ = seated
+    nc = len(specs)
+    knee = plant.GetJointByName("l_knee").velocity_start()
+    commands = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    impossible = _FixedBounds([knee], [5.0], [100.0])
+    hard = _qp(plant, specs, None, acceleration_bounds=impossible)
+    assert not hard.solve(terms, _references(2), commands).ok
+    soft = _qp(plant, specs, None, soft_bounds=impossible, soft_bound_weight=1e3)
+    solution = soft.solve(terms, _references(2), commands)
+    assert solution.ok
+    assert abs(solution.vdot[knee]) < 1e-6
+    assert abs(solution.slack[0]) == pytest.approx(5.0, rel=1e-6)

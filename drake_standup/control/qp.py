@@ -218,10 +218,10 @@ class WholeBodyQp:
     ):
         """contact_map: the active contacts and their map (the tasks may share it).
         tasks: the cost's tasks. acceleration_bounds: bounds on entries of vdot, computed
-        each tick (None: none). soft_bounds: bounds that a slack s >= 0 per entry may
-        exceed, vdot_min - s <= vdot <= vdot_max + s, at the cost soft_bound_weight s^2
-        (the slacks come last in z, after the layout's unknowns): the program stays
-        feasible whatever the state."""
+        each tick (None: none). soft_bounds: bounds that a slack s per entry may move,
+        vdot_min <= vdot - s <= vdot_max, at the cost soft_bound_weight s^2 (at the
+        optimum |s| is the violation; one two-sided row per entry, the slacks last in z,
+        after the layout's unknowns): the program stays feasible whatever the state."""
         nv, nu = B.shape
         if not (np.all((B == 0) | (B == 1)) and np.all(B.sum(axis=0) == 1)):
             raise ValueError("the actuation matrix B must select one velocity per actuator")
@@ -248,8 +248,8 @@ class WholeBodyQp:
         cones = [wrench_cone_matrix(spec) for spec in contacts]
         row = rows_acc.stop
         rows_cones = slice(row, row + sum(len(K) for K in cones))
-        # Soft bounds: vdot_i - s_i <= vdot_max_i, then vdot_i + s_i >= vdot_min_i.
-        rows_soft = slice(rows_cones.stop, rows_cones.stop + 2 * n_soft)
+        # Soft bounds: vdot_min_i <= vdot_i - s_i <= vdot_max_i.
+        rows_soft = slice(rows_cones.stop, rows_cones.stop + n_soft)
         rows_dynamics = slice(rows_soft.stop, rows_soft.stop + N_BASE + nu)
         self._rows_tau = slice(rows_dynamics.start + N_BASE, rows_dynamics.stop)
         m = self._rows_tau.stop
@@ -268,12 +268,8 @@ class WholeBodyQp:
             columns = layout.vdot.start + np.asarray(soft_bounds.v_indices, dtype=int)
             A[rows_soft.start + entries, columns] = 1.0
             A[rows_soft.start + entries, self._slack.start + entries] = -1.0
-            A[rows_soft.start + n_soft + entries, columns] = 1.0
-            A[rows_soft.start + n_soft + entries, self._slack.start + entries] = 1.0
-            lo[self._slack] = 0.0
-            bounds = self._bounds(rows_soft)
-            self._soft_hi = hi[bounds][:n_soft]
-            self._soft_lo = lo[bounds][n_soft:]
+            self._soft_lo = lo[self._bounds(rows_soft)]
+            self._soft_hi = hi[self._bounds(rows_soft)]
         # The constrained contacts' rows are equalities (all rows held) until solve() gets
         # ContactCommands.partially_held: the last one it got.
         self._equality[self._bounds(rows_acc)] = 1

@@ -172,6 +172,8 @@ class TaskReferences:
     lean_W: np.ndarray  # (3,) the CoM target's lean against the pull this tick, m
     # The momentum task's vertical row weight, a fraction of its weight (state 4's end).
     vertical_weight_scale: float
+    # How far the legs have taken over the end of the rise, 0-1 (state 4).
+    stance: float
     # The posture state after this tick: [latched flag, first tick's posture (nu),
     # q_ref's next value (nu), first tick's base yaw].
     next_posture: np.ndarray
@@ -341,5 +343,6 @@ class ReferenceGenerator:
             helpful_force_W=f_par,
             lean_W=lean,
             vertical_weight_scale=vertical_weight_scale,
+            stance=stance,
             next_posture=np.concatenate((self._latched, q_initial, q_next, (base_yaw,))),
         )

@@ -125,6 +125,22 @@ class PostureTask(Task):
         )
 
 
+class StancePostureTask(PostureTask):
+    """A PostureTask whose weights grow with the stance factor (TaskReferences.stance,
+    0 -> 1 over the end of the rise): joints held only once the legs end the rise."""
+
+    name = "stance_posture"
+    constant_A = False
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._full_weight = self.weight.copy()
+
+    def update(self, terms: RobotTerms, references: TaskReferences) -> None:
+        super().update(terms, references)
+        self.weight = self._full_weight * references.stance
+
+
 def posture_acceleration_reference(
     q: np.ndarray, qdot: np.ndarray, q_reference: np.ndarray, kp_per_s2: float, kd_per_s: float
 ) -> np.ndarray:
