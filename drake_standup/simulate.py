@@ -25,6 +25,7 @@ from pydrake.systems.framework import EventStatus
 
 from drake_standup import outputs
 from drake_standup.config import Scenario
+from drake_standup.controller import WholeBodyController
 from drake_standup.diagram import StandupDiagram, build_diagram
 from drake_standup.perturbations import apply_model_errors
 from drake_standup.progress import ProgressBar
@@ -423,6 +424,10 @@ def make_signals(built: StandupDiagram, root_context) -> dict[str, np.ndarray]:
         diagnostics = rows("controller_diagnostics")
         signals["qp_ok"] = diagnostics[:, 0] > 0.5
         signals["qp_failures"] = diagnostics[:, 1].astype(np.int64)
+        # What the QP asked of each of its contacts (NaN where it failed): against
+        # pad_normal_force_N it shows where the controller's contact model is wrong.
+        signals["commanded_contacts"] = np.array(WholeBodyController.CONTACTS, dtype=str)
+        signals["commanded_normal_force_N"] = diagnostics[:, 4:9]
     if "push_force_W" in logs:
         signals["push_force_W"] = rows("push_force_W")
     return signals
