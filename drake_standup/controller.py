@@ -9,7 +9,9 @@ torques.
 Ports
     robot_state      (nq + nv)  [q (quaternion wxyz, p_WB, joints); v (w_WB, v_WB, joints)]
     com_reference    (9)        [x_d, xd_dot, xd_ddot], world, m, m/s, m/s^2
-    contact_plan     (3)        [standup_state 1-4, seat_scale 0-1, feet_scale 0-1]
+    contact_plan     (6)        [standup_state 1-4, seat_scale 0-1, feet_scale 0-1, what is
+                                 left of the load of seat, l_thigh, r_thigh (0-1; NaN:
+                                 seated)]
     hand_wrenches_W  (12)       [tau_l, f_l, tau_r, f_r], world, at the hand frames' origins
     -> actuation     (nu)       joint torques, actuator order, N m (zero-order held)
     -> diagnostics   (10)       see DIAGNOSTICS
@@ -20,9 +22,14 @@ forces on the thigh pads) and both soles (6-D). The seat and soles are held by t
 only. From state 2 on, the seat lets the pelvis pitch about the hip axis (the thighs stay
 on the chair) so that the trunk can bring the CoM over the feet.
 
-Contact plan: seat_scale scales the seat's and thighs' normal-force bounds (the plan
-ramps it to 0 to release the seat; at 0 they are dropped); feet_scale scales the soles'
-minimum normal force (0 drops them). standup_state picks, in one table
+Contact plan: seat_scale scales the seat's and thighs' normal-force bounds while seated
+(the plan ramps it to 0 to release the seat; at 0 they are dropped); feet_scale scales
+the soles' minimum normal force (0 drops them). While a seat pad unloads, the plan gives
+what is left of its load (state_machine.seat_unloading, 1 -> 0): its normal force is then
+bounded by that fraction of the force the controller commanded it when its unloading
+began, with no minimum (a pad lifting off cannot push). Once the buttocks are unloaded
+the seat holds no rows: nothing holds the pelvis then but the thighs' and soles' forces,
+and the CoM task moves the whole body. standup_state picks, in one table
 (control/references.py: StandupSchedule), the CoM gains (seated 1-2, standing 3-4), the
 base pitch, the posture reference (state 1: the posture at the first tick) and whether
 the seat is hinged.
@@ -166,11 +173,12 @@ class ControllerConfig:
     foot_cop_x_m: list[float] = field(default_factory=lambda: [-0.05, 0.10])
     foot_cop_y_m: list[float] = field(default_factory=lambda: [-0.025, 0.025])
     # CoP box of the seat contact in its frame: the seat acts on root_link, whose only pad
-    # is the buttocks pad (x in [-0.12, -0.02], y in [-0.06, 0.06] of the seat frame,
-    # models/icub_contact.yaml), 1 cm inside; the thighs are contacts of their own. A box
-    # over the thigh pads (SPEC 7's +-0.11) let the QP ask for a CoP the buttocks cannot
-    # give and the pelvis rolled forward onto the thighs (measured). m.
-    seat_cop_x_m: list[float] = field(default_factory=lambda: [-0.11, -0.03])
+    # is the buttocks pad (x in [-0.12, -0.05], y in [-0.06, 0.06] of the seat frame,
+    # models/icub_contact.yaml: behind the hip axis at x = -0.0365), 1 cm inside; the
+    # thighs are contacts of their own. A box over the thigh pads (SPEC 7's +-0.11) let
+    # the QP ask for a CoP the buttocks cannot give and the pelvis rolled forward onto the
+    # thighs (measured). m.
+    seat_cop_x_m: list[float] = field(default_factory=lambda: [-0.11, -0.06])
     seat_cop_y_m: list[float] = field(default_factory=lambda: [-0.05, 0.05])
     # Joint torque saturation (SPEC 3). N m.
     torque_limit_Nm: float = 60.0
@@ -279,6 +287,7 @@ class ControllerTick:
     normal_forces_N: np.ndarray  # commanded f_z of every contact (CONTACTS), 0 if inactive
     helpful_force_W: np.ndarray  # f_par, N
     posture: np.ndarray  # next value of the posture state (see __init__)
+    unloading: np.ndarray  # next value of the unloading memory (see __init__)
     inputs_s: float  # evaluating the input ports (and the upstream systems behind them)
     kinematics_s: float
     assembly_s: float
@@ -370,13 +379,16 @@ class WholeBodyController(LeafSystem):
         nx = plant.num_positions(robot.model_instance) + nv
         self._state_port = self.DeclareVectorInputPort("robot_state", nx)
         self._reference_port = self.DeclareVectorInputPort("com_reference", 9)
-        self._plan_port = self.DeclareVectorInputPort("contact_plan", 3)
+        self._plan_port = self.DeclareVectorInputPort("contact_plan", 6)
         self._hands_port = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         self._actuation = self.DeclareDiscreteState(nu)
         self._diagnostics = self.DeclareDiscreteState(len(self.DIAGNOSTICS))
         self._momentum_integral = self.DeclareDiscreteState(3)  # int L_ang dt, N m s^2
         # [latched flag, state-1 posture (nu), filtered posture reference (nu), base yaw].
         self._posture = self.DeclareDiscreteState(2 + 2 * nu)
+        # Unloading memory of the seat and thighs: [the commanded loads their unloading
+        # started from (3), their last commanded loads (3)], N.
+        self._unloading = self.DeclareDiscreteState(6)
         self.DeclareStateOutputPort("actuation", self._actuation)
         self.DeclareStateOutputPort("diagnostics", self._diagnostics)
         # Initialization event: the plant's first step already sees computed torques.
@@ -406,7 +418,7 @@ class WholeBodyController(LeafSystem):
         F_hand_W = self._hands_port.Eval(context)
         t_inputs = time.perf_counter()
 
-        standup_state, seat_scale, feet_scale = plan.tolist()
+        standup_state, seat_scale, feet_scale = plan[:3].tolist()
         standup_state = min(max(int(round(standup_state)), 1), 4)
         program = self._program((seat_scale > 0.0, feet_scale > 0.0))
         pulled = bool(F_hand_W.any())
@@ -422,18 +434,24 @@ class WholeBodyController(LeafSystem):
             state.get_value(self._momentum_integral),
             state.get_value(self._posture),
         )
-        commands = self._contact_commands(program, references.state.seat_hinged, plan)
+        unloading = self._next_unloading(state.get_value(self._unloading), plan)
+        commands = self._contact_commands(
+            program, references.state.seat_hinged, plan, unloading[:3]
+        )
         t_tasks = time.perf_counter()
         solution = program.qp.solve(terms, references, commands)
 
         normal_forces_N = np.zeros(len(self.CONTACTS))
         normal_forces_N[program.contact_index] = solution.F_C[:, NORMAL]
+        if solution.ok:
+            unloading[3:] = normal_forces_N[:3]
         return ControllerTick(
             solution=solution,
             terms=terms,
             normal_forces_N=normal_forces_N,
             helpful_force_W=references.helpful_force_W,
             posture=references.next_posture,
+            unloading=unloading,
             inputs_s=t_inputs - t_start,
             kinematics_s=t_kinematics - t_inputs,
             assembly_s=t_tasks - t_kinematics + solution.assembly_s,
@@ -480,16 +498,26 @@ class WholeBodyController(LeafSystem):
                 solver=config.qp_solver,
             )
             soles = np.array([spec.frame in ("l_sole", "r_sole") for spec in contacts])
+            seated = np.flatnonzero(~soles)
             program = _Program(
                 qp=qp,
                 frames=qp.frames,
                 contact_index=[self.CONTACTS.index(spec.frame) for spec in contacts],
                 plan_index=np.array([self.PLAN_SCALE[spec.frame] for spec in contacts]),
                 soles=soles,
+                seated=seated,
+                seat_index=np.array(
+                    [self.CONTACTS.index(contacts[c].frame) for c in seated], dtype=int
+                ),
                 partially_held={
-                    False: {},
-                    True: {
+                    "held": {},
+                    "hinged": {
                         c: self._hinged_rows
+                        for c, spec in enumerate(contacts)
+                        if spec.constrained and not soles[c]
+                    },
+                    "free": {
+                        c: np.zeros(WRENCH_SIZE, dtype=bool)
                         for c, spec in enumerate(contacts)
                         if spec.constrained and not soles[c]
                     },
@@ -498,23 +526,50 @@ class WholeBodyController(LeafSystem):
             self._programs[active] = program
         return program
 
+    @staticmethod
+    def _next_unloading(memory: np.ndarray, plan: np.ndarray) -> np.ndarray:
+        """The unloading memory for this tick: a seat pad whose unloading starts now (its
+        fraction at 1 or above, i.e. the ramp's first ticks, or NaN before) starts from
+        its last commanded load. Seated (NaN) pads keep following their commands."""
+        unloading = memory.copy()
+        seated = ~np.isfinite(plan[3:6]) | (plan[3:6] >= 1.0)
+        unloading[:3][seated] = memory[3:][seated]
+        return unloading
+
     def _contact_commands(
-        self, program: "_Program", seat_hinged: bool, plan: np.ndarray
+        self,
+        program: "_Program",
+        seat_hinged: bool,
+        plan: np.ndarray,
+        unload_from_N: np.ndarray,
     ) -> ContactCommands:
         """Normal-force bounds from the plan: seat and thighs in seat_scale * [f_min,
-        f_max_seat], soles in [feet_scale * f_min, f_max_foot]. The seat holds all six
-        rows until it is hinged (StateReferences.seat_hinged), then all but the pitch about
-        the hip axis."""
+        f_max_seat] while seated, in [0, fraction * the load they unload from] while they
+        unload; soles in [feet_scale * f_min, f_max_foot]. The seat holds all six rows until
+        it is hinged (StateReferences.seat_hinged), then all but the pitch about the hip
+        axis, and none once the buttocks are unloaded: held with no force, the seat kept
+        the hips still while the thighs unloaded, asking the soles to keep the pelvis
+        hovering; the CoM fell 2-7 cm behind its reference, and when the hold dropped at
+        the end of the release that error came back as a 300 N jolt on the soles and the
+        thighs landed again (measured)."""
         config = self._config
         scales = plan[program.plan_index]
+        min_normal_force_N = scales * config.min_normal_force_N
         max_normal_force_N = np.where(
             program.soles, config.foot_max_normal_force_N, scales * config.seat_max_normal_force_N
         )
-        return ContactCommands(
-            scales * config.min_normal_force_N,
-            max_normal_force_N,
-            program.partially_held[seat_hinged],
-        )
+        fractions = plan[3 + program.seat_index]
+        unloading = np.isfinite(fractions)
+        seated = program.seated[unloading]
+        min_normal_force_N[seated] = 0.0
+        max_normal_force_N[seated] = fractions[unloading] * unload_from_N[
+            program.seat_index[unloading]
+        ]
+        if np.isfinite(plan[3]):  # the buttocks unloading
+            hold = "free"
+        else:
+            hold = "hinged" if seat_hinged else "held"
+        return ContactCommands(min_normal_force_N, max_normal_force_N, program.partially_held[hold])
 
     def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
         t_start = time.perf_counter()
@@ -527,6 +582,7 @@ class WholeBodyController(LeafSystem):
         integral = state.get_value(self._momentum_integral) + self._period_s * tick.terms.L_WCom[:3]
         discrete_state.set_value(self._momentum_integral, integral)
         discrete_state.set_value(self._posture, tick.posture)
+        discrete_state.set_value(self._unloading, tick.unloading)
         total_s = time.perf_counter() - t_start
         diagnostics = np.empty(len(self.DIAGNOSTICS))
         f_par = tick.helpful_force_W
@@ -548,5 +604,9 @@ class _Program:
     contact_index: list[int]  # of each contact in WholeBodyController.CONTACTS
     plan_index: np.ndarray  # of each contact's scale in contact_plan
     soles: np.ndarray  # True for a sole
-    # ContactCommands.partially_held before (False) and from (True) seat_hinge_from_state.
-    partially_held: dict[bool, dict[int, np.ndarray]]
+    seated: np.ndarray  # the program's seat and thigh contacts (indices)
+    seat_index: np.ndarray  # ... their index in CONTACTS (0 seat, 1-2 thighs)
+    # ContactCommands.partially_held with the seat held (all rows: state 1), hinged (from
+    # seat_hinge_from_state: all but the pitch about the hip axis) and free (no rows: the
+    # release, from state 3).
+    partially_held: dict[str, dict[int, np.ndarray]]
