@@ -19,17 +19,20 @@ Ports
 Contacts: the seat (a 6-D contact on root_link under the buttocks), both thighs (point
 forces on the thigh pads) and both soles (6-D). The seat and soles are held by the QP
 (their frames do not accelerate); the thighs are then pinned already and carry forces
-only. From state 2 on, the seat lets the pelvis pitch about the hip axis (the thighs stay
-on the chair) so that the trunk can bring the CoM over the feet.
+only. The seat may let the pelvis pitch about the hip axis from seat_hinge_from_state on,
+but only until its unloading begins: with the default plan that is the same instant
+(state 2), so the hinge no longer acts. Hinged through state 2 (held rows, no force) the
+QP counted on a support the chair did not give: the thighs chattered 0-150 N and the
+stand-up fell backwards for a 0.05 s change of the unloading time (measured).
 
 Contact plan: seat_scale scales the seat's and thighs' normal-force bounds while seated
 (the plan ramps it to 0 to release the seat; at 0 they are dropped); feet_scale scales
 the soles' minimum normal force (0 drops them). While a seat pad unloads, the plan gives
 what is left of its load (state_machine.seat_unloading, 1 -> 0): its normal force is then
 bounded by that fraction of the force the controller commanded it when its unloading
-began, with no minimum (a pad lifting off cannot push). Once the buttocks are unloaded
-the seat holds no rows: nothing holds the pelvis then but the thighs' and soles' forces,
-and the CoM task moves the whole body. standup_state picks, in one table
+began, with no minimum (a pad lifting off cannot push). From the moment the buttocks
+start to unload the seat holds no rows: nothing holds the pelvis then but the thighs' and
+soles' forces, and the CoM task moves the whole body. standup_state picks, in one table
 (control/references.py: StandupSchedule), the CoM gains (seated 1-2, standing 3-4), the
 base pitch, the posture reference (state 1: the posture at the first tick) and whether
 the seat is hinged.
@@ -547,7 +550,7 @@ class WholeBodyController(LeafSystem):
         f_max_seat] while seated, in [0, fraction * the load they unload from] while they
         unload; soles in [feet_scale * f_min, f_max_foot]. The seat holds all six rows until
         it is hinged (StateReferences.seat_hinged), then all but the pitch about the hip
-        axis, and none once the buttocks are unloaded: held with no force, the seat kept
+        axis, and none once the buttocks unload: held with no force, the seat kept
         the hips still while the thighs unloaded, asking the soles to keep the pelvis
         hovering; the CoM fell 2-7 cm behind its reference, and when the hold dropped at
         the end of the release that error came back as a 300 N jolt on the soles and the
