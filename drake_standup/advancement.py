@@ -26,13 +26,16 @@ ratio = psi_dot: any psi_dot sustains itself, and the smallest helpful pull ran
 psi_dot to its bound (5 N per hand: 2.47 of 2.5; the stand-up time jumped 0.87 s
 between 0 and 5 N, measured). So the law's excess over 1 is weighted,
 
-    psi_dot = 1 + w g (clip(ratio, 1, upper) - 1),
+    psi_dot = 1 + w g s (clip(ratio, 1, upper) - 1),
     w = min(1, (alpha - alpha_min) / (alpha_full - alpha_min)),
     g = min(1, 1 + lead / lag_tolerance)   (0 at a lag of lag_tolerance),
+    s = 1 - smoothstep((progress - taper_from) / (1 - taper_from))   (segment's end),
 
 and with ratio = psi_dot + e (e: the CoM's speed-up the help causes, in psi
-units) the rate settles at psi_dot - 1 = e w g / (1 - w g): growing smoothly with
-the help, the paper's law (w = g = 1) from alpha_full on, psi = t without help.
+units) the rate settles at psi_dot - 1 = e w g / (1 - w g): growing with the
+help, the paper's law (w = g = s = 1) from alpha_full on, psi = t without help.
+The taper s returns psi_dot to 1 before each segment ends (a rise ending at
+psi_dot 2.5 drove the knees onto their stop, measured).
 """
 
 from __future__ import annotations
@@ -67,9 +70,11 @@ def psi_dot_law(
     omega_f: np.ndarray,
     tangent: np.ndarray,
     lead_m: float | Callable[[], float] = 0.0,
+    progress: float = 0.0,
 ) -> tuple[float, float]:
     """(psi_dot, alpha) by the configured update law; lead_m feeds the lead gate
-    (or a function giving it, called only when the gate decides).
+    (or a function giving it, called only when the gate decides); progress: how far
+    along its segment the reference is (0-1), for the taper at the segment's end.
 
     psi_dot = 1 + w(alpha) g(lead) (clip(ratio, 1, upper) - 1): the paper's law where
     the help is full (w = g = 1), psi = t where there is none; the weights grade the
@@ -83,6 +88,11 @@ def psi_dot_law(
             1.0,
             (alpha - config.alpha_min_mps2) / (config.alpha_full_mps2 - config.alpha_min_mps2),
         )
+    if progress > config.taper_from_progress:
+        r = (progress - config.taper_from_progress) / (1.0 - config.taper_from_progress)
+        weight *= 1.0 - min(r, 1.0) ** 2 * (3.0 - 2.0 * min(r, 1.0))
+        if weight <= 0.0:
+            return 1.0, alpha
     if config.lead_gate:
         if callable(lead_m):
             lead_m = lead_m()
@@ -123,6 +133,8 @@ class TrajectoryAdvancement(LeafSystem):
         self._omega_f = self.DeclareVectorInputPort("omega_f_W", 3)
         self._x_d = self.DeclareVectorInputPort("x_d_W", 3)
         self._tangent = self.DeclareVectorInputPort("path_tangent_W", 3)
+        # Unconnected (unit tests): no taper.
+        self._progress = self.DeclareVectorInputPort("path_progress", 1)
         self.DeclareVectorOutputPort(
             "psi",
             1,
@@ -132,7 +144,15 @@ class TrajectoryAdvancement(LeafSystem):
         # The law reads the inputs only: evaluated once per change of them,
         # however many outputs and integrator stages ask.
         inputs = {
-            port.ticket() for port in (self._com, self._v, self._omega_f, self._x_d, self._tangent)
+            port.ticket()
+            for port in (
+                self._com,
+                self._v,
+                self._omega_f,
+                self._x_d,
+                self._tangent,
+                self._progress,
+            )
         }
         self._law_cache = declare_cached(self, "psi_dot law", self._calc_law, inputs)
         law = {self._law_cache.ticket()}
@@ -158,6 +178,7 @@ class TrajectoryAdvancement(LeafSystem):
             tangent,
             # Only while the interaction helps (a few seconds of a stand-up).
             lambda: lead(self._com.Eval(context), self._x_d.Eval(context), tangent),
+            self._progress.Eval(context)[0] if self._progress.HasValue(context) else 0.0,
         )
 
     def _psi_ddot(self, context: Context) -> float:

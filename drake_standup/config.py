@@ -184,8 +184,14 @@ class AdvancementConfig:
     # between, psi_dot's excess over 1 is weighted by (alpha - alpha_min) /
     # (alpha_full - alpha_min). alpha_full <= alpha_min: the paper's on/off
     # gate. The default pull (15 + 15 N per hand) gives alpha ~0.9 m/s^2 at
-    # its peak (measured). m/s^2.
-    alpha_full_mps2: float = 1.0
+    # its peak (measured): the paper's law in full from the default pull on. m/s^2.
+    alpha_full_mps2: float = 0.9
+    # Over the last part of each segment (path progress from taper_from_progress
+    # to 1) the law's excess over 1 is tapered to 0 (smoothstep), so psi_dot
+    # returns to 1 before the path ends: the rise at psi_dot 2.5 ended on
+    # straight knees and the standing robot rocked between its feet (measured;
+    # from 0.7 it still did).
+    taper_from_progress: float = 0.4
     # Advance only while the CoM is not behind its reference along the path
     # (see advancement.py: without it the law and the tracker run away). The
     # tolerance admits the tracker's steady lag. m.
@@ -237,9 +243,25 @@ class StandupConfig:
     # ... after at least this long in state 3 (SPEC 3: 0.5 s, the segment's
     # length; enforced in psi as for state 2). s
     min_time_state3_s: float = 0.0
-    # The seat's normal-force bound ramps to zero over this time after the
-    # switch to state 3 (SPEC 7). s.
-    seat_release_s: float = 1.0
+    # The thighs' normal-force bounds ramp to zero over this time after the
+    # switch to state 3 (SPEC 7), and state 4 waits for the ramp's end: with
+    # 1 s the bound (400 N scaled) bound only in the last 0.3 s, and state 4
+    # began with the hips still pinned by the seat (measured). s.
+    seat_release_s: float = 0.5
+    # The buttocks' normal force ramps from its load to zero over this time
+    # after the switch to state 2: the pelvis pitching forward about the hips
+    # lifts the buttocks pad (it lies behind the hip axis) off the seat. The
+    # controller had held it at >= 10 N, and for ~1 s asked >= 10 N of a pad
+    # carrying < 1 N (measured). s.
+    seat_unload_s: float = 0.2
+    # The force guards (state_machine.py) read forces low-pass filtered with
+    # this time constant: the pads' contact forces ring at 20-50 Hz. s.
+    force_filter_time_constant_s: float = 0.05
+    # ... through Schmitt triggers: on after the filtered force stays above
+    # the threshold for guard_dwell_s, off after it stays below guard_off_ratio
+    # times the threshold as long. s, -.
+    guard_dwell_s: float = 0.05
+    guard_off_ratio: float = 0.8
     # Period of the state machine's update; the authors' whole controller ran
     # at 100 Hz (SPEC 3), and the guards' thresholds are met for seconds. s.
     update_period_s: float = 0.01
@@ -735,6 +757,10 @@ def _validate_advancement(adv: AdvancementConfig) -> None:
     _positive("advancement.alpha_min_mps2", adv.alpha_min_mps2, allow_zero=True)
     _positive("advancement.lag_tolerance_m", adv.lag_tolerance_m, allow_zero=True)
     _positive("advancement.alpha_full_mps2", adv.alpha_full_mps2, allow_zero=True)
+    if not 0.0 <= adv.taper_from_progress < 1.0:
+        raise ScenarioError(
+            f"advancement.taper_from_progress: {adv.taper_from_progress}; accepted: [0, 1)"
+        )
     _positive("advancement.psi_ddot_filter_s", adv.psi_ddot_filter_s)
 
 
@@ -753,9 +779,16 @@ def _validate_standup(st: StandupConfig) -> None:
         "foot_force_3to4_N",
         "min_time_state3_s",
         "seat_release_s",
+        "seat_unload_s",
+        "force_filter_time_constant_s",
+        "guard_dwell_s",
     ):
         _positive(f"standup.{name}", getattr(st, name), allow_zero=True)
     _positive("standup.standing_com_height_m", st.standing_com_height_m)
+    if not 0.0 <= st.guard_off_ratio <= 1.0:
+        raise ScenarioError(
+            f"standup.guard_off_ratio: {st.guard_off_ratio}; accepted: a number in [0, 1]"
+        )
     _positive("standup.update_period_s", st.update_period_s)
 
 

@@ -9,7 +9,9 @@ torques.
 Ports
     robot_state      (nq + nv)  [q (quaternion wxyz, p_WB, joints); v (w_WB, v_WB, joints)]
     com_reference    (9)        [x_d, xd_dot, xd_ddot], world, m, m/s, m/s^2
-    contact_plan     (3)        [standup_state 1-4, seat_scale 0-1, feet_scale 0-1]
+    contact_plan     (6)        [standup_state 1-4, seat_scale 0-1, feet_scale 0-1, what is
+                                 left of the load of seat, l_thigh, r_thigh (0-1; NaN:
+                                 seated)]
     hand_wrenches_W  (12)       [tau_l, f_l, tau_r, f_r], world, at the hand frames' origins
     -> actuation     (nu)       joint torques, actuator order, N m (zero-order held)
     -> diagnostics   (13)       see DIAGNOSTICS
@@ -17,12 +19,20 @@ Ports
 Contacts: the seat (a 6-D contact on root_link under the buttocks), both thighs (point
 forces on the thigh pads) and both soles (6-D). The seat and soles are held by the QP
 (their frames do not accelerate); the thighs are then pinned already and carry forces
-only. From state 2 on, the seat lets the pelvis pitch about the hip axis (the thighs stay
-on the chair) so that the trunk can bring the CoM over the feet.
+only. The seat may let the pelvis pitch about the hip axis from seat_hinge_from_state on,
+but only until its unloading begins: with the default plan that is the same instant
+(state 2), so the hinge no longer acts. Hinged through state 2 (held rows, no force) the
+QP counted on a support the chair did not give: the thighs chattered 0-150 N and the
+stand-up fell backwards for a 0.05 s change of the unloading time (measured).
 
-Contact plan: seat_scale scales the seat's and thighs' normal-force bounds (the plan
-ramps it to 0 to release the seat; at 0 they are dropped); feet_scale scales the soles'
-minimum normal force (0 drops them). standup_state picks, in one table
+Contact plan: seat_scale scales the seat's and thighs' normal-force bounds while seated
+(the plan ramps it to 0 to release the seat; at 0 they are dropped); feet_scale scales
+the soles' minimum normal force (0 drops them). While a seat pad unloads, the plan gives
+what is left of its load (state_machine.seat_unloading, 1 -> 0): its normal force is then
+bounded by that fraction of the force the controller commanded it when its unloading
+began, with no minimum (a pad lifting off cannot push). From the moment the buttocks
+start to unload the seat holds no rows: nothing holds the pelvis then but the thighs' and
+soles' forces, and the CoM task moves the whole body. standup_state picks, in one table
 (control/references.py: StandupSchedule), the CoM gains (seated 1-2, standing 3-4), the
 base pitch, the posture reference (state 1: the posture at the first tick) and whether
 the seat is hinged.
@@ -165,6 +175,9 @@ class ControllerConfig:
     # Seat (and each thigh) normal-force bound at seat_scale = 1: above the robot's weight
     # (324 N), so it binds only while the plan ramps it down (SPEC 7 release). N.
     seat_max_normal_force_N: float = 400.0
+    # While the seat pads unload, each is bounded by its measured normal force plus
+    # this (controller._contact_commands). N.
+    seat_measured_margin_N: float = 20.0
     # Sole normal-force bound: three times the robot's weight, never binding. N.
     foot_max_normal_force_N: float = 1000.0
     # CoP box of each sole in its l_sole/r_sole frame (SPEC 3; inside the 0.19 x 0.09 m
@@ -172,11 +185,12 @@ class ControllerConfig:
     foot_cop_x_m: list[float] = field(default_factory=lambda: [-0.05, 0.10])
     foot_cop_y_m: list[float] = field(default_factory=lambda: [-0.025, 0.025])
     # CoP box of the seat contact in its frame: the seat acts on root_link, whose only pad
-    # is the buttocks pad (x in [-0.12, -0.02], y in [-0.06, 0.06] of the seat frame,
-    # models/icub_contact.yaml), 1 cm inside; the thighs are contacts of their own. A box
-    # over the thigh pads (SPEC 7's +-0.11) let the QP ask for a CoP the buttocks cannot
-    # give and the pelvis rolled forward onto the thighs (measured). m.
-    seat_cop_x_m: list[float] = field(default_factory=lambda: [-0.11, -0.03])
+    # is the buttocks pad (x in [-0.12, -0.05], y in [-0.06, 0.06] of the seat frame,
+    # models/icub_contact.yaml: behind the hip axis at x = -0.0365), 1 cm inside; the
+    # thighs are contacts of their own. A box over the thigh pads (SPEC 7's +-0.11) let
+    # the QP ask for a CoP the buttocks cannot give and the pelvis rolled forward onto the
+    # thighs (measured). m.
+    seat_cop_x_m: list[float] = field(default_factory=lambda: [-0.11, -0.06])
     seat_cop_y_m: list[float] = field(default_factory=lambda: [-0.05, 0.05])
     # Joint torque saturation (SPEC 3). N m.
     torque_limit_Nm: float = 60.0
@@ -211,7 +225,7 @@ class ControllerConfig:
     # straight legs 1 cm of CoM height is 0.3 rad of knee (measured): a CoM target there
     # drove the knees onto their stop, and the soles slid (measured).
     stance_from_progress: float = 0.7
-    stance_vertical_weight_scale: float = 1.0e-3
+    stance_vertical_weight_scale: float = 0.1
     # Standup states in which the CoM target leans against the hands' pull so that the
     # feet's CoP stays where it is without the pull (control/references.py: static_lean):
     # standing, a 15 + 15 N pull per hand needed the CoP past the toes (measured).
@@ -331,6 +345,7 @@ class ControllerTick:
     helpful_force_W: np.ndarray  # f_par, N
     posture: np.ndarray  # next value of the posture state (see __init__)
     lean_W: np.ndarray  # next value of the lean state, m
+    unloading: np.ndarray  # next value of the unloading memory (see __init__)
     inputs_s: float  # evaluating the input ports (and the upstream systems behind them)
     kinematics_s: float
     assembly_s: float
@@ -400,7 +415,10 @@ class WholeBodyController(LeafSystem):
             for key in ("stance_posture_weight_by_joint", "stance_arm_weight_by_joint")
         )
         self._joint_limits = JointLimitBounds(
-            joints.q_indices, joints.v_indices, joints.q_min, joints.q_max,
+            joints.q_indices,
+            joints.v_indices,
+            joints.q_min,
+            joints.q_max,
             config.joint_limit_horizon_s,
         )
         self._kinematics = RobotKinematics(
@@ -427,8 +445,11 @@ class WholeBodyController(LeafSystem):
         nx = plant.num_positions(robot.model_instance) + nv
         self._state_port = self.DeclareVectorInputPort("robot_state", nx)
         self._reference_port = self.DeclareVectorInputPort("com_reference", 9)
-        self._plan_port = self.DeclareVectorInputPort("contact_plan", 3)
+        self._plan_port = self.DeclareVectorInputPort("contact_plan", 6)
         self._hands_port = self.DeclareVectorInputPort("hand_wrenches_W", 12)
+        # Measured normal forces on the buttocks, left and right thigh pads (N), in
+        # CONTACTS' order of the seat contacts; unconnected (unit tests): not used.
+        self._seat_pads_port = self.DeclareVectorInputPort("seat_pad_normal_forces_N", 3)
         # Unconnected (unit tests): taken as 1, the segment finished.
         self._progress_port = self.DeclareVectorInputPort("path_progress", 1)
         self._actuation = self.DeclareDiscreteState(nu)
@@ -437,6 +458,9 @@ class WholeBodyController(LeafSystem):
         # [latched flag, state-1 posture (nu), filtered posture reference (nu), base yaw].
         self._posture = self.DeclareDiscreteState(2 + 2 * nu)
         self._lean = self.DeclareDiscreteState(3)  # the CoM target's lean, m
+        # Unloading memory of the seat and thighs: [the commanded loads their unloading
+        # started from (3), their last commanded loads (3)], N.
+        self._unloading = self.DeclareDiscreteState(6)
         self.DeclareStateOutputPort("actuation", self._actuation)
         self.DeclareStateOutputPort("diagnostics", self._diagnostics)
         # Initialization event: the plant's first step already sees computed torques.
@@ -471,7 +495,7 @@ class WholeBodyController(LeafSystem):
         )
         t_inputs = time.perf_counter()
 
-        standup_state, seat_scale, feet_scale = plan.tolist()
+        standup_state, seat_scale, feet_scale = plan[:3].tolist()
         standup_state = min(max(int(round(standup_state)), 1), 4)
         program = self._program((seat_scale > 0.0, feet_scale > 0.0))
         pulled = bool(F_hand_W.any())
@@ -489,12 +513,20 @@ class WholeBodyController(LeafSystem):
             state.get_value(self._lean),
             progress,
         )
-        commands = self._contact_commands(program, references.state.seat_hinged, plan)
+        unloading = self._next_unloading(state.get_value(self._unloading), plan)
+        measured = (
+            self._seat_pads_port.Eval(context) if self._seat_pads_port.HasValue(context) else None
+        )
+        commands = self._contact_commands(
+            program, references.state.seat_hinged, plan, unloading[:3], measured
+        )
         t_tasks = time.perf_counter()
         solution = program.qp.solve(terms, references, commands)
 
         normal_forces_N = np.zeros(len(self.CONTACTS))
         normal_forces_N[program.contact_index] = solution.F_C[:, NORMAL]
+        if solution.ok:
+            unloading[3:] = normal_forces_N[:3]
         return ControllerTick(
             solution=solution,
             terms=terms,
@@ -502,6 +534,7 @@ class WholeBodyController(LeafSystem):
             helpful_force_W=references.helpful_force_W,
             posture=references.next_posture,
             lean_W=references.lean_W,
+            unloading=unloading,
             inputs_s=t_inputs - t_start,
             kinematics_s=t_kinematics - t_inputs,
             assembly_s=t_tasks - t_kinematics + solution.assembly_s,
@@ -569,16 +602,26 @@ class WholeBodyController(LeafSystem):
                 solver=config.qp_solver,
             )
             soles = np.array([spec.frame in ("l_sole", "r_sole") for spec in contacts])
+            seated = np.flatnonzero(~soles)
             program = _Program(
                 qp=qp,
                 frames=qp.frames,
                 contact_index=[self.CONTACTS.index(spec.frame) for spec in contacts],
                 plan_index=np.array([self.PLAN_SCALE[spec.frame] for spec in contacts]),
                 soles=soles,
+                seated=seated,
+                seat_index=np.array(
+                    [self.CONTACTS.index(contacts[c].frame) for c in seated], dtype=int
+                ),
                 partially_held={
-                    False: {},
-                    True: {
+                    "held": {},
+                    "hinged": {
                         c: self._hinged_rows
+                        for c, spec in enumerate(contacts)
+                        if spec.constrained and not soles[c]
+                    },
+                    "free": {
+                        c: np.zeros(WRENCH_SIZE, dtype=bool)
                         for c, spec in enumerate(contacts)
                         if spec.constrained and not soles[c]
                     },
@@ -587,23 +630,62 @@ class WholeBodyController(LeafSystem):
             self._programs[active] = program
         return program
 
+    @staticmethod
+    def _next_unloading(memory: np.ndarray, plan: np.ndarray) -> np.ndarray:
+        """The unloading memory for this tick: a seat pad whose unloading starts now (its
+        fraction at 1 or above, i.e. the ramp's first ticks, or NaN before) starts from
+        its last commanded load. Seated (NaN) pads keep following their commands."""
+        unloading = memory.copy()
+        seated = ~np.isfinite(plan[3:6]) | (plan[3:6] >= 1.0)
+        unloading[:3][seated] = memory[3:][seated]
+        return unloading
+
     def _contact_commands(
-        self, program: "_Program", seat_hinged: bool, plan: np.ndarray
+        self,
+        program: "_Program",
+        seat_hinged: bool,
+        plan: np.ndarray,
+        unload_from_N: np.ndarray,
+        measured_N: np.ndarray | None = None,
     ) -> ContactCommands:
         """Normal-force bounds from the plan: seat and thighs in seat_scale * [f_min,
-        f_max_seat], soles in [feet_scale * f_min, f_max_foot]. The seat holds all six
-        rows until it is hinged (StateReferences.seat_hinged), then all but the pitch about
-        the hip axis."""
+        f_max_seat] while seated, in [0, fraction * the load they unload from] while they
+        unload; soles in [feet_scale * f_min, f_max_foot]. The seat holds all six rows until
+        it is hinged (StateReferences.seat_hinged), then all but the pitch about the hip
+        axis, and none once the buttocks unload: held with no force, the seat kept
+        the hips still while the thighs unloaded, asking the soles to keep the pelvis
+        hovering; the CoM fell 2-7 cm behind its reference, and when the hold dropped at
+        the end of the release that error came back as a 300 N jolt on the soles and the
+        thighs landed again (measured). While they unload, the seat pads are also bounded
+        by their measured load plus seat_measured_margin_N: the thighs are forces the QP
+        does not pin, and it planned on up to three times what the compliant pads carried
+        (in state 3, 145 N against 49 N, measured). Not in state 2: there the bound fed
+        back (less commanded, less carried) and unloaded the thighs with the CoM still
+        behind the feet: every scenario fell backwards (measured)."""
         config = self._config
         scales = plan[program.plan_index]
+        min_normal_force_N = scales * config.min_normal_force_N
         max_normal_force_N = np.where(
             program.soles, config.foot_max_normal_force_N, scales * config.seat_max_normal_force_N
         )
-        return ContactCommands(
-            scales * config.min_normal_force_N,
-            max_normal_force_N,
-            program.partially_held[seat_hinged],
+        fractions = plan[3 + program.seat_index]
+        unloading = np.isfinite(fractions)
+        seated = program.seated[unloading]
+        min_normal_force_N[seated] = 0.0
+        max_normal_force_N[seated] = (
+            fractions[unloading] * unload_from_N[program.seat_index[unloading]]
         )
+        if measured_N is not None:
+            max_normal_force_N[seated] = np.minimum(
+                max_normal_force_N[seated],
+                np.maximum(measured_N[program.seat_index[unloading]], 0.0)
+                + config.seat_measured_margin_N,
+            )
+        if np.isfinite(plan[3]):  # the buttocks unloading
+            hold = "free"
+        else:
+            hold = "hinged" if seat_hinged else "held"
+        return ContactCommands(min_normal_force_N, max_normal_force_N, program.partially_held[hold])
 
     def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
         t_start = time.perf_counter()
@@ -617,6 +699,7 @@ class WholeBodyController(LeafSystem):
         discrete_state.set_value(self._momentum_integral, integral)
         discrete_state.set_value(self._posture, tick.posture)
         discrete_state.set_value(self._lean, tick.lean_W)
+        discrete_state.set_value(self._unloading, tick.unloading)
         total_s = time.perf_counter() - t_start
         diagnostics = np.empty(len(self.DIAGNOSTICS))
         f_par = tick.helpful_force_W
@@ -640,5 +723,9 @@ class _Program:
     contact_index: list[int]  # of each contact in WholeBodyController.CONTACTS
     plan_index: np.ndarray  # of each contact's scale in contact_plan
     soles: np.ndarray  # True for a sole
-    # ContactCommands.partially_held before (False) and from (True) seat_hinge_from_state.
-    partially_held: dict[bool, dict[int, np.ndarray]]
+    seated: np.ndarray  # the program's seat and thigh contacts (indices)
+    seat_index: np.ndarray  # ... their index in CONTACTS (0 seat, 1-2 thighs)
+    # ContactCommands.partially_held with the seat held (all rows: state 1), hinged (from
+    # seat_hinge_from_state: all but the pitch about the hip axis) and free (no rows: the
+    # release, from state 3).
+    partially_held: dict[str, dict[int, np.ndarray]]

@@ -9,7 +9,12 @@ from pydrake.geometry import Meshcat, MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
 from pydrake.multibody.plant import ExternallyAppliedSpatialForceMultiplexer
 from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
-from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
+from pydrake.systems.primitives import (
+    ConstantVectorSource,
+    LogVectorOutput,
+    MatrixGain,
+    VectorLogSink,
+)
 
 from drake_standup.advancement import TrajectoryAdvancement
 from drake_standup.config import Scenario
@@ -103,7 +108,7 @@ def build_diagram(
     builder.Connect(hand_wrenches, sensing.GetInputPort("hand_wrenches_W"))
     for name in ("com_W", "com_velocity_W", "omega_f_W"):
         builder.Connect(sensing.GetOutputPort(name), advancement.GetInputPort(name))
-    for name in ("x_d_W", "path_tangent_W"):
+    for name in ("x_d_W", "path_tangent_W", "path_progress"):
         builder.Connect(reference.GetOutputPort(name), advancement.GetInputPort(name))
     for name in ("psi", "psi_dot", "psi_ddot"):
         builder.Connect(advancement.GetOutputPort(name), reference.GetInputPort(name))
@@ -133,6 +138,15 @@ def build_diagram(
         builder.Connect(
             reference.GetOutputPort("path_progress"),
             controller_system.GetInputPort("path_progress"),
+        )
+        # The seat pads' measured normal forces (z of the buttocks and thigh pads).
+        select = np.zeros((3, 3 * len(pad_names)))
+        for row, pad in enumerate(_seat_pads(robot)):
+            select[row, 3 * pad_names.index(pad) + 2] = 1.0
+        seat_pads = builder.AddNamedSystem("seat_pad_forces", MatrixGain(select))
+        builder.Connect(reporter.get_output_port(), seat_pads.get_input_port())
+        builder.Connect(
+            seat_pads.get_output_port(), controller_system.GetInputPort("seat_pad_normal_forces_N")
         )
         builder.Connect(
             controller_system.GetOutputPort("actuation"), plant.get_actuation_input_port(instance)
@@ -196,6 +210,13 @@ def build_diagram(
         logs,
         visualizer,
     )
+
+
+def _seat_pads(robot) -> list[str]:
+    """The contact pads under the controller's seat contacts, in its order: the buttocks,
+    the left thigh, the right thigh."""
+    by_frame = {shape.frame: shape.name for shape in robot.contact_shapes}
+    return [by_frame[robot.TASK_FRAMES[task]] for task in ("buttocks", "l_thigh", "r_thigh")]
 
 
 def on_step_grid(period_s: float, step_s: float) -> float:

@@ -250,28 +250,63 @@ def standup_metrics(
     signals: dict[str, np.ndarray],
     entry_times_s,
     *,
-    com_tolerance_m: float = 0.02,
-    unloaded_N: float = 1.0,
+    standing_height_m: float | None = None,
+    height_tolerance_m: float = 0.01,
+    unloaded_N: float = 5.0,
+    hold_s: float = 0.2,
 ) -> dict:
     """Stand-up time, CoM tracking and whether the robot is standing at the end.
 
-    Standing at a sample: state 4, the reference at its end (psi past the last
-    segment), the CoM within com_tolerance_m of the reference, and nothing but
-    the soles loaded (every other pad below unloaded_N). standup_time_s runs
-    from entering state 2 to the first standing sample (None if never).
+    The stand-up is measured from its outcome, not from a guard's instant. Standing at a
+    sample: the CoM within height_tolerance_m of the standing height, and every pad group
+    but the soles (thighs, buttocks) carrying less than unloaded_N in all. The standing
+    height is standing_height_m, the erect height (simulate.py: the CoM height of the
+    state-4 posture, scene.erect_com_height_m); without it, the run's own: the CoM
+    reference's height at the end of the run, once its last segment (state 4) has run
+    through (None otherwise: the run never set it). Where the controller leans the CoM
+    against a pull (signals com_lean_W, a horizontal shift d), the standing height is
+    that of the posture tilted about the feet, sqrt(height^2 - |d|^2).
+    standup_time_s runs from entering state 2 to the first standing sample from which
+    the robot stays standing for hold_s (None if never); standing_at_end: standing at
+    the last sample. 5 N is the unloading level of issue 12's chatter count: 1.5 % of
+    the robot's weight, above the 1-3 N a pad still feels while it lifts off a
+    compliant seat, far below the 50-170 N the thighs carry seated.
     """
     t = signals["time_s"]
     error = np.linalg.norm(signals["com_W"] - signals["com_reference_W"], axis=1)
-    others = [i for i, g in enumerate(signals["pad_groups"]) if str(g) != "soles"]
-    seat_free = np.all(signals["pad_normal_force_N"][:, others] < unloaded_N, axis=1)
-    path_done = signals["psi"] - signals["segment_psi_entry"] >= signals["segment_psi_length"]
-    standing = (signals["state"] == 4) & path_done & (error <= com_tolerance_m) & seat_free
     metrics: dict = {
         "com_tracking_rms_m": float(np.sqrt(np.mean(error**2))) if len(t) else None,
-        "standing_at_end": bool(standing[-1]) if len(t) else False,
+        "standing_at_end": False,
+        "standing_com_height_m": None,
         "standup_time_s": None,
     }
+    if not len(t):
+        return metrics
+    if standing_height_m is None:
+        done = signals["psi"] - signals["segment_psi_entry"] >= signals["segment_psi_length"]
+        if not (signals["state"][-1] == 4 and done[-1]):
+            return metrics
+        height = float(signals["com_reference_W"][-1, 2])
+    else:
+        height = float(standing_height_m)
+    metrics["standing_com_height_m"] = height
+    seat = [f for g, f in group_normal_forces(signals).items() if g != "soles"]
+    unloaded = np.all(np.array(seat) < unloaded_N, axis=0) if seat else np.ones(len(t), bool)
+    if "com_lean_W" in signals:
+        # Leaning against a pull tilts the standing robot about its feet: the erect
+        # height is then that of the tilted posture (the controller's own target).
+        lean = signals["com_lean_W"]
+        height = np.sqrt(np.maximum(height**2 - lean[:, 0] ** 2 - lean[:, 1] ** 2, 0.0))
+    standing = (np.abs(signals["com_W"][:, 2] - height) <= height_tolerance_m) & unloaded
+    metrics["standing_at_end"] = bool(standing[-1])
+    # Standing from sample i through t[i] + hold_s: no non-standing sample up to the
+    # last sample within the hold, and the run lasts that long.
+    not_standing = np.r_[0, np.cumsum(~standing)]
+    last = np.searchsorted(t, t + hold_s - 1e-9, side="right") - 1
+    held = (not_standing[last + 1] - not_standing[:-1] == 0) & (t[-1] >= t + hold_s - 1e-9)
     t2 = entry_times_s[1]
-    if standing.any() and t2 is not None and np.isfinite(t2):
-        metrics["standup_time_s"] = float(t[np.argmax(standing)] - t2)
+    if t2 is not None and np.isfinite(t2):
+        held &= t >= t2
+        if held.any():
+            metrics["standup_time_s"] = float(t[np.argmax(held)] - t2)
     return metrics

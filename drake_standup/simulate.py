@@ -25,10 +25,11 @@ from pydrake.systems.framework import EventStatus
 
 from drake_standup import outputs
 from drake_standup.config import Scenario
+from drake_standup.controller import WholeBodyController
 from drake_standup.diagram import StandupDiagram, build_diagram
 from drake_standup.perturbations import apply_model_errors
 from drake_standup.progress import ProgressBar
-from drake_standup.scene import set_seated_state
+from drake_standup.scene import erect_com_height_m, set_seated_state
 
 GRAVITY_MPS2 = 9.81
 
@@ -423,9 +424,12 @@ def make_signals(built: StandupDiagram, root_context) -> dict[str, np.ndarray]:
         diagnostics = rows("controller_diagnostics")
         signals["qp_ok"] = diagnostics[:, 0] > 0.5
         signals["qp_failures"] = diagnostics[:, 1].astype(np.int64)
-        if diagnostics.shape[1] >= 13:
-            signals["joint_limit_slack"] = diagnostics[:, 10]
-            signals["com_lean_W"] = np.c_[diagnostics[:, 11:13], np.zeros(len(t))]
+        signals["joint_limit_slack"] = diagnostics[:, 10]
+        signals["com_lean_W"] = np.c_[diagnostics[:, 11:13], np.zeros(len(t))]
+        # What the QP asked of each of its contacts (NaN where it failed): against
+        # pad_normal_force_N it shows where the controller's contact model is wrong.
+        signals["commanded_contacts"] = np.array(WholeBodyController.CONTACTS, dtype=str)
+        signals["commanded_normal_force_N"] = diagnostics[:, 4:9]
     if "push_force_W" in logs:
         signals["push_force_W"] = rows("push_force_W")
     return signals
@@ -451,16 +455,22 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
         built.advancement.GetMyContextFromRoot(root_context)
     )[0]
     metrics.update(outputs.advancement_metrics(psi_now, signals["psi_dot"], entry_times))
-    metrics.update(outputs.standup_metrics(signals, metrics["state_entry_times_s"]))
+    metrics.update(
+        outputs.standup_metrics(
+            signals,
+            metrics["state_entry_times_s"],
+            standing_height_m=erect_com_height_m(
+                built.scene, scenario, scenario.controller.posture_state4_rad
+            ),
+        )
+    )
     if "qp_failures" in signals:
         metrics["qp_failures"] = int(signals["qp_failures"][-1]) if len(signals["time_s"]) else 0
     if "joint_limit_slack" in signals and len(signals["time_s"]):
         slack = signals["joint_limit_slack"]
         metrics["joint_limit_slack_peak"] = float(slack.max())
         metrics["joint_limit_slack_integral"] = float(
-            np.sum(slack) * (signals["time_s"][1] - signals["time_s"][0])
-            if len(slack) > 1
-            else 0.0
+            np.sum(slack) * (signals["time_s"][1] - signals["time_s"][0]) if len(slack) > 1 else 0.0
         )
     torques = signals["joint_torques_Nm"]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None

@@ -2,17 +2,30 @@
 
     1 balance seated     -> 2 after balance_time_s, and with trigger 'hands'
                               once both hands feel a forward pull > threshold
-    2 CoM forward        -> 3 after min_time_state2_s, the state-2 segment done,
+    2 CoM forward, the buttocks unloaded over seat_unload_s
+                         -> 3 after min_time_state2_s, the state-2 segment done,
                               feet normal forces together > feet_force_2to3_N,
                               the CoM >= com_ahead_of_heels_m in front of the heels
-    3 CoM forward, seat released over seat_release_s
-                         -> 4 after min_time_state3_s, the segment done, each
-                              foot's normal force > foot_force_3to4_N
+    3 CoM forward, the thighs unloaded over seat_release_s
+                         -> 4 after min_time_state3_s and the release, the
+                              segment done, each foot's normal force >
+                              foot_force_3to4_N
     4 CoM up to standing (final)
 (SPEC 3 and 7.) "Segment done" (psi past the segment's end) keeps the
 reference's slope continuous across switches; with psi_dot >= 1 it costs
 nothing when the dwell time is at least the segment length. One switch per
 update at most, so no state is ever skipped.
+
+The force guards read low-pass filtered forces (first order,
+force_filter_time_constant_s) through Schmitt triggers: a condition turns on
+once its filtered force has stayed above the threshold for guard_dwell_s, and
+off once it has stayed below guard_off_ratio times the threshold for as long,
+so noise around a threshold cannot flip a guard back and forth. The filters
+and triggers live in the mode: next_mode stays a pure function.
+
+The contact plan says what is left of each seat pad's load while it unloads
+(NaN while seated): the buttocks from 1 to 0 over seat_unload_s from state 2,
+each thigh over seat_release_s from state 3 (smoothstep in both).
 """
 
 from __future__ import annotations
@@ -32,8 +45,43 @@ N_STATES = 4
 
 
 @dataclass(frozen=True)
+class SchmittTrigger:
+    """A condition with hysteresis and dwell: on after the value has stayed above the on
+    threshold for the dwell, off after it has stayed below the off threshold as long."""
+
+    on: bool = False
+    # Since when the value has been past the threshold that would flip the trigger
+    # (NaN: it is not).
+    pending_since_s: float = math.nan
+
+    def update(
+        self, value: float, t: float, on_above: float, off_below: float, dwell_s: float
+    ) -> SchmittTrigger:
+        crossing = value < off_below if self.on else value > on_above
+        if not crossing:
+            return self if math.isnan(self.pending_since_s) else SchmittTrigger(self.on)
+        since = t if math.isnan(self.pending_since_s) else self.pending_since_s
+        if t - since >= dwell_s - 1e-9:
+            return SchmittTrigger(not self.on)
+        return SchmittTrigger(self.on, since)
+
+
+@dataclass(frozen=True)
+class GuardSignals:
+    """Filtered forces and the triggers the guards read."""
+
+    t: float = math.nan  # time of the last update (NaN: none yet)
+    foot_fz_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
+    hand_fx_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
+    hands_pulled: SchmittTrigger = SchmittTrigger()  # both hands > hand threshold
+    feet_loaded: SchmittTrigger = SchmittTrigger()  # the feet together > feet_force_2to3_N
+    each_foot_loaded: SchmittTrigger = SchmittTrigger()  # each foot > foot_force_3to4_N
+
+
+@dataclass(frozen=True)
 class StandupMode:
-    """The machine's abstract state: where it is and the active CoM segment."""
+    """The machine's abstract state: where it is, the active CoM segment, the guards'
+    filtered signals and the seat pads' loads when their unloading began."""
 
     state: int = 1
     entry_times_s: tuple[float, ...] = (0.0,) + (math.nan,) * (N_STATES - 1)
@@ -41,6 +89,7 @@ class StandupMode:
     segment_psi: float = 1.0
     x_start_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     delta_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    guards: GuardSignals = GuardSignals()
 
     def __copy__(self) -> StandupMode:
         return self
@@ -76,25 +125,59 @@ def initial_mode(com0_W: np.ndarray) -> StandupMode:
     return StandupMode(x_start_m=tuple(float(c) for c in com0_W))
 
 
+def _low_pass(previous: tuple[float, ...], raw: tuple[float, ...], gain: float) -> tuple:
+    return tuple(float(y + gain * (x - y)) for y, x in zip(previous, raw, strict=True))
+
+
+def update_guards(g: GuardSignals, m: Measurements, cfg: StandupConfig) -> GuardSignals:
+    """The guards' signals after a measurement: forces filtered (first order, exact for a
+    step held over the update: gain 1 - exp(-dt / tau); the first measurement starts the
+    filters), then the triggers."""
+    if math.isnan(g.t):
+        feet, hands = tuple(m.foot_fz_N), tuple(m.hand_fx_N)
+    else:
+        tau = cfg.force_filter_time_constant_s
+        gain = 1.0 if tau <= 0 else 1.0 - math.exp(-max(m.t - g.t, 0.0) / tau)
+        feet = _low_pass(g.foot_fz_N, m.foot_fz_N, gain)
+        hands = _low_pass(g.hand_fx_N, m.hand_fx_N, gain)
+    off, dwell = cfg.guard_off_ratio, cfg.guard_dwell_s
+    hand_on, feet_on, foot_on = (
+        cfg.hand_force_threshold_N,
+        cfg.feet_force_2to3_N,
+        cfg.foot_force_3to4_N,
+    )
+    return GuardSignals(
+        t=m.t,
+        foot_fz_N=feet,
+        hand_fx_N=hands,
+        hands_pulled=g.hands_pulled.update(min(hands), m.t, hand_on, off * hand_on, dwell),
+        feet_loaded=g.feet_loaded.update(sum(feet), m.t, feet_on, off * feet_on, dwell),
+        each_foot_loaded=g.each_foot_loaded.update(min(feet), m.t, foot_on, off * foot_on, dwell),
+    )
+
+
 def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> StandupMode:
-    """The mode after one update: the same, or the next state."""
+    """The mode after one update: its guards' signals updated, in the same or the next
+    state."""
+    g = update_guards(mode.guards, m, cfg)
+    mode = dataclasses.replace(mode, guards=g)
     dwell = m.t - mode.entry_times_s[mode.state - 1]
     segment_done = m.psi - mode.psi_entry >= mode.segment_psi
     if mode.state == 1:
-        pulled = min(m.hand_fx_N) > cfg.hand_force_threshold_N
-        go = dwell >= cfg.balance_time_s and (cfg.trigger == "time" or pulled)
+        go = dwell >= cfg.balance_time_s and (cfg.trigger == "time" or g.hands_pulled.on)
     elif mode.state == 2:
         go = (
             dwell >= cfg.min_time_state2_s
             and segment_done
-            and sum(m.foot_fz_N) > cfg.feet_force_2to3_N
+            and g.feet_loaded.on
             and m.com_W[0] >= m.heel_x + cfg.com_ahead_of_heels_m
         )
     elif mode.state == 3:
         go = (
             dwell >= cfg.min_time_state3_s
+            and dwell >= cfg.seat_release_s  # the thighs unloaded
             and segment_done
-            and min(m.foot_fz_N) > cfg.foot_force_3to4_N
+            and g.each_foot_loaded.on
         )
     else:
         go = False
@@ -107,6 +190,14 @@ def _enter(mode: StandupMode, state: int, m: Measurements, cfg: StandupConfig) -
     # State 1 holds its start, so its "end" is x_start; later segments have
     # finished (segment_done), so they end at x_start + delta exactly.
     x_start = mode.segment_end()
+    if state == 3:
+        # Bumpless: state 3 stiffens the CoM's height (com_kp_standing: 30 against 5
+        # seated), and the forward lean of state 2 leaves the CoM 1-3 cm below the
+        # seated height. Kept, that error became a step in the demanded lift that
+        # unloaded the thighs at once (48 -> 20 N in 20 ms, measured) and they landed
+        # again; the segment starts at the CoM's height instead, and state 4 rises
+        # from there.
+        x_start[2] = float(m.com_W[2])
     if state == 2:
         delta = np.array(cfg.state2_com_delta_m)
     elif state == 3:
@@ -135,15 +226,40 @@ def seat_scale(mode: StandupMode, t: float, cfg: StandupConfig) -> float:
     return max(0.0, 1.0 - (t - mode.entry_times_s[2]) / cfg.seat_release_s)
 
 
+def _smoothstep(r: float) -> float:
+    r = min(max(r, 0.0), 1.0)
+    return r * r * (3.0 - 2.0 * r)
+
+
+def seat_unloading(mode: StandupMode, t: float, cfg: StandupConfig) -> np.ndarray:
+    """What is left of the load of the buttocks (seat contact) and of each thigh, as a
+    fraction of their load when their unloading began; NaN while the pad is seated (the
+    controller's choice). Smoothstep from 1 to 0: the buttocks over seat_unload_s from
+    state 2 (the pelvis pitching forward about the hips lifts them), the thighs over
+    seat_release_s from state 3 (smoothstep of seat_scale)."""
+    fractions = np.full(3, math.nan)
+    if mode.state >= 2:
+        if cfg.seat_unload_s <= 0:
+            fractions[0] = 0.0
+        else:
+            fractions[0] = _smoothstep(1.0 - (t - mode.entry_times_s[1]) / cfg.seat_unload_s)
+    if mode.state >= 3:
+        fractions[1:] = _smoothstep(seat_scale(mode, t, cfg))
+    return fractions
+
+
 class StandupStateMachine(LeafSystem):
     """Periodic (update_period_s) state machine with the mode as abstract state.
 
     Inputs: psi (1), com_W (3), heel_x_W (1), pad_forces_W (3 per pad, rows of
     the soles given as sole_rows = (left, right)), hand_wrenches_W (12).
     Outputs: standup_state (1), segment (8: [psi_entry, T, x_start, delta]),
-    contact_plan (3: [state, seat_scale, feet_scale]), entry_times_s (4, NaN
-    for states not reached).
+    contact_plan (6: [state, seat_scale, feet_scale, then what is left of the
+    load of the seat, left thigh, right thigh (seat_unloading; NaN: seated)]),
+    entry_times_s (4, NaN for states not reached).
     """
+
+    PLAN_SIZE = 6
 
     def __init__(self, config: StandupConfig, n_pads: int, sole_rows: tuple[int, int]):
         super().__init__()
@@ -166,7 +282,7 @@ class StandupStateMachine(LeafSystem):
         )
         self.DeclareVectorOutputPort(
             "contact_plan",
-            3,
+            self.PLAN_SIZE,
             self._CalcContactPlan,
             prerequisites_of_calc={
                 self.abstract_state_ticket(self._mode_index),
@@ -203,8 +319,7 @@ class StandupStateMachine(LeafSystem):
     def _Update(self, context: Context, state: State) -> None:
         mode = self.mode(context)
         new = next_mode(mode, self._measure(context), self._cfg)
-        if new is not mode:
-            state.get_mutable_abstract_state(self._mode_index).set_value(new)
+        state.get_mutable_abstract_state(self._mode_index).set_value(new)
 
     def _CalcState(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, self.mode(context).state)
@@ -214,7 +329,12 @@ class StandupStateMachine(LeafSystem):
 
     def _CalcContactPlan(self, context: Context, output: BasicVector) -> None:
         mode = self.mode(context)
-        output.SetFromVector([mode.state, seat_scale(mode, context.get_time(), self._cfg), 1.0])
+        t = context.get_time()
+        output.SetFromVector(
+            np.r_[
+                mode.state, seat_scale(mode, t, self._cfg), 1.0, seat_unloading(mode, t, self._cfg)
+            ]
+        )
 
     def _CalcEntryTimes(self, context: Context, output: BasicVector) -> None:
         output.SetFromVector(np.array(self.mode(context).entry_times_s))

@@ -6,6 +6,8 @@ momentum functions), frame poses and the joints' damping, independently of the
 controller's code; a second QP solver checks the first.
 """
 
+import math
+
 import numpy as np
 import pytest
 from pydrake.common.yaml import yaml_load_typed
@@ -46,6 +48,10 @@ NO_PULL = np.zeros(12)
 
 
 def _fix_inputs(controller, context, x, com_reference, plan, hand_wrenches=NO_PULL):
+    """plan: [state, seat_scale, feet_scale] (the seat pads seated: no unloading) or the
+    whole contact plan."""
+    if len(plan) == 3:
+        plan = [*plan, math.nan, math.nan, math.nan]
     controller.GetInputPort("robot_state").FixValue(context, x)
     controller.GetInputPort("com_reference").FixValue(context, com_reference)
     controller.GetInputPort("contact_plan").FixValue(context, plan)
@@ -463,7 +469,7 @@ def test_ports_and_config(scene):
     sizes = {
         "robot_state": plant.num_positions() + plant.num_velocities(),
         "com_reference": 9,
-        "contact_plan": 3,
+        "contact_plan": 6,
         "hand_wrenches_W": 12,
     }
     for name, size in sizes.items():

@@ -68,6 +68,7 @@ DEFAULT_SYSTEMS = {
     "advancement",
     "com_reference",
     "contact_forces",
+    "seat_pad_forces",
     "controller",
     "human",
     "plant",

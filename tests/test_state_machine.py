@@ -1,5 +1,6 @@
 """The stand-up state machine on synthetic inputs: thresholds, dwell times,
-one state at a time; and the LeafSystem's timing on its update grid."""
+one state at a time, filtered forces through Schmitt triggers, the seat's
+unloading plan; and the LeafSystem's timing on its update grid."""
 
 from __future__ import annotations
 
@@ -12,11 +13,15 @@ from pydrake.systems.analysis import Simulator
 
 from drake_standup.config import StandupConfig
 from drake_standup.state_machine import (
+    GuardSignals,
     Measurements,
+    SchmittTrigger,
     StandupStateMachine,
     initial_mode,
     next_mode,
     seat_scale,
+    seat_unloading,
+    update_guards,
 )
 
 # The authors' dwell times (SPEC 3; our defaults leave the dwell to psi), so
@@ -28,6 +33,21 @@ AHEAD = np.array([0.30, 0.0, 0.40])  # CoM far in front of the heels
 
 def _m(t, psi=None, com=AHEAD, heel_x=0.1, feet=(200.0, 200.0), hands=(20.0, 20.0)):
     return Measurements(t, t if psi is None else psi, com, heel_x, feet, hands)
+
+
+def _settled(mode, m, cfg=CFG):
+    """mode with its guards' signals as if m's forces had been measured for the last
+    second (every 10 ms): filters settled, triggers past their dwell."""
+    g = GuardSignals()
+    for k in range(100, 0, -1):
+        g = update_guards(g, dataclasses.replace(m, t=m.t - 0.01 * k), cfg)
+    return dataclasses.replace(mode, guards=g)
+
+
+def _next(mode, m, cfg=CFG):
+    """next_mode on a mode whose guards have settled on m's forces: the thresholds, as if
+    the forces had held long enough."""
+    return next_mode(_settled(mode, m, cfg), m, cfg)
 
 
 def _in_state(state: int, t_entry: float, cfg=CFG):
@@ -47,17 +67,17 @@ def _force_enter(mode, state, t, cfg):
 def test_1_to_2_needs_balance_time_and_both_hands_over_threshold():
     mode = initial_mode(COM0)
     thr = CFG.hand_force_threshold_N
-    assert next_mode(mode, _m(2.999, hands=(50, 50)), CFG).state == 1  # too early
-    assert next_mode(mode, _m(3.5, hands=(thr, 50)), CFG).state == 1  # exactly at: not >
-    assert next_mode(mode, _m(3.5, hands=(50, thr - 1)), CFG).state == 1  # one hand only
-    assert next_mode(mode, _m(3.0, hands=(thr + 1e-9, thr + 1e-9)), CFG).state == 2
+    assert _next(mode, _m(2.999, hands=(50, 50)), CFG).state == 1  # too early
+    assert _next(mode, _m(3.5, hands=(thr, 50)), CFG).state == 1  # exactly at: not >
+    assert _next(mode, _m(3.5, hands=(50, thr - 1)), CFG).state == 1  # one hand only
+    assert _next(mode, _m(3.0, hands=(thr + 1e-9, thr + 1e-9)), CFG).state == 2
 
 
 def test_1_to_2_with_time_trigger_ignores_hands():
     cfg = dataclasses.replace(CFG, trigger="time")
     mode = initial_mode(COM0)
-    assert next_mode(mode, _m(2.999, hands=(0, 0)), cfg).state == 1
-    new = next_mode(mode, _m(3.0, hands=(0, 0)), cfg)
+    assert _next(mode, _m(2.999, hands=(0, 0)), cfg).state == 1
+    new = _next(mode, _m(3.0, hands=(0, 0)), cfg)
     assert new.state == 2 and new.entry_times_s[1] == 3.0
 
 
@@ -68,28 +88,28 @@ def test_2_to_3_guards():
     heel = 0.1
     com_ok = np.array([heel + CFG.com_ahead_of_heels_m, 0.0, 0.4])
     ok = {"feet": (thr / 2 + 1e-9, thr / 2 + 1e-9), "com": com_ok, "heel_x": heel}
-    assert next_mode(mode, _m(t_ok, **ok), CFG).state == 3  # all at their thresholds
-    assert next_mode(mode, _m(t_ok - 1e-6, **ok), CFG).state == 2  # dwell
-    assert next_mode(mode, _m(t_ok, **{**ok, "feet": (thr / 2, thr / 2)}), CFG).state == 2
+    assert _next(mode, _m(t_ok, **ok), CFG).state == 3  # all at their thresholds
+    assert _next(mode, _m(t_ok - 1e-6, **ok), CFG).state == 2  # dwell
+    assert _next(mode, _m(t_ok, **{**ok, "feet": (thr / 2, thr / 2)}), CFG).state == 2
     com_behind = com_ok - np.array([1e-6, 0.0, 0.0])
-    assert next_mode(mode, _m(t_ok, **{**ok, "com": com_behind}), CFG).state == 2
+    assert _next(mode, _m(t_ok, **{**ok, "com": com_behind}), CFG).state == 2
     # Segment not finished (psi behind): no switch, whatever the forces.
-    assert next_mode(mode, _m(t_ok, psi=t_ok - 1e-6, **ok), CFG).state == 2
+    assert _next(mode, _m(t_ok, psi=t_ok - 1e-6, **ok), CFG).state == 2
 
 
 def test_3_to_4_needs_each_foot():
     mode = _in_state(3, 5.0)
     t_ok = 5.0 + CFG.min_time_state3_s
     thr = CFG.foot_force_3to4_N
-    assert next_mode(mode, _m(t_ok, feet=(thr + 1e-9, thr + 1e-9)), CFG).state == 4
-    assert next_mode(mode, _m(t_ok, feet=(thr, 500.0)), CFG).state == 3
-    assert next_mode(mode, _m(t_ok, feet=(500.0, thr)), CFG).state == 3
-    assert next_mode(mode, _m(t_ok - 1e-6, feet=(500.0, 500.0)), CFG).state == 3
+    assert _next(mode, _m(t_ok, feet=(thr + 1e-9, thr + 1e-9)), CFG).state == 4
+    assert _next(mode, _m(t_ok, feet=(thr, 500.0)), CFG).state == 3
+    assert _next(mode, _m(t_ok, feet=(500.0, thr)), CFG).state == 3
+    assert _next(mode, _m(t_ok - 1e-6, feet=(500.0, 500.0)), CFG).state == 3
 
 
 def test_state_4_is_final():
     mode = _in_state(4, 6.0)
-    assert next_mode(mode, _m(100.0), CFG) is mode
+    assert _next(mode, _m(100.0), CFG).state == 4
 
 
 def test_never_skips_a_state_even_when_every_guard_holds():
@@ -97,7 +117,7 @@ def test_never_skips_a_state_even_when_every_guard_holds():
     states = [mode.state]
     t = 10.0  # every dwell satisfied; psi far past every segment
     for _ in range(5):
-        mode = next_mode(mode, _m(t, psi=10.0 * t), CFG)
+        mode = _next(mode, _m(t, psi=10.0 * t), CFG)
         states.append(mode.state)
         t += 10.0
     assert states == [1, 2, 3, 4, 4, 4]
@@ -150,3 +170,121 @@ def test_entry_times_are_nan_until_reached():
     context = system.CreateDefaultContext()
     entries = system.GetOutputPort("entry_times_s").Eval(context)
     assert entries[0] == 0.0 and all(math.isnan(e) for e in entries[1:])
+
+
+# --- Filtered forces, Schmitt triggers, dwell ------------------------------------------
+
+
+def _feet_trace(t, total_N):
+    """Measurements every 10 ms with the feet carrying total_N (split evenly)."""
+    return [
+        Measurements(float(tk), float(tk), AHEAD, 0.1, (f / 2, f / 2), (0.0, 0.0))
+        for tk, f in zip(t, total_N, strict=True)
+    ]
+
+
+def test_noisy_force_around_the_threshold_switches_once():
+    """The feet's load ramps through the 2 -> 3 threshold (150 N) with +-40 N of white
+    noise: the raw force crosses it dozens of times, the trigger turns on once and stays."""
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 3.0, 0.01)
+    mean = np.interp(t, [0.0, 3.0], [100.0, 220.0])
+    total = mean + rng.uniform(-40.0, 40.0, len(t))
+    thr = CFG.feet_force_2to3_N
+    raw_crossings = np.count_nonzero(np.diff((total > thr).astype(int)) != 0)
+    assert raw_crossings > 10  # the noise would flip a bare threshold
+    g, on = GuardSignals(), []
+    for m in _feet_trace(t, total):
+        g = update_guards(g, m, CFG)
+        on.append(g.feet_loaded.on)
+    switches = np.flatnonzero(np.diff(np.array(on, dtype=int)))
+    assert len(switches) == 1 and on[-1]
+    # ... near where the mean crosses the threshold (1.25 s), within the filter's lag
+    # and the dwell.
+    assert 0.9 < t[switches[0] + 1] < 1.7
+
+
+def test_dwell_rejects_a_short_spike_and_accepts_a_held_load():
+    thr = CFG.feet_force_2to3_N
+    t = np.arange(0.0, 1.0, 0.01)
+    # A 300 N spike for 20 ms: the filtered force passes 150 N (166 N), but not for the
+    # dwell.
+    spike = np.where((t >= 0.5) & (t < 0.52), 300.0, 100.0)
+    g = GuardSignals()
+    for m in _feet_trace(t, spike):
+        g = update_guards(g, m, CFG)
+        assert not g.feet_loaded.on
+    # Held: on at the first update at least guard_dwell_s after the filtered force
+    # passed the threshold, i.e. after the filter's lag tau ln(2) (step 100 -> 200 N).
+    held = np.where(t >= 0.5, 200.0, 100.0)
+    g, t_on = GuardSignals(), None
+    for m in _feet_trace(t, held):
+        g = update_guards(g, m, CFG)
+        if g.feet_loaded.on and t_on is None:
+            t_on = m.t
+    lag = CFG.force_filter_time_constant_s * math.log((200.0 - 100.0) / (200.0 - thr))
+    assert t_on == pytest.approx(0.5 + lag + CFG.guard_dwell_s, abs=0.011)
+
+
+def test_schmitt_trigger_hysteresis():
+    """Off only below the off threshold, held for the dwell; values between the two
+    thresholds change nothing."""
+    trig = SchmittTrigger()
+    trig = trig.update(11.0, 0.0, 10.0, 8.0, 0.05)
+    assert not trig.on
+    trig = trig.update(11.0, 0.05, 10.0, 8.0, 0.05)
+    assert trig.on
+    for k, value in enumerate([9.0, 8.5, 9.9, 8.1] * 5):  # between: stays on
+        trig = trig.update(value, 0.06 + 0.01 * k, 10.0, 8.0, 0.05)
+        assert trig.on
+    trig = trig.update(7.0, 1.0, 10.0, 8.0, 0.05)
+    trig = trig.update(9.0, 1.03, 10.0, 8.0, 0.05)  # back between: the dwell restarts
+    trig = trig.update(7.0, 1.06, 10.0, 8.0, 0.05)
+    assert trig.on
+    trig = trig.update(7.0, 1.11, 10.0, 8.0, 0.05)
+    assert not trig.on
+
+
+def test_filter_is_first_order():
+    """A step seen every 10 ms: the filtered force after time t is 1 - exp(-t / tau)."""
+    g = update_guards(GuardSignals(), _m(0.0, feet=(0.0, 0.0)), CFG)
+    for k in range(1, 11):
+        g = update_guards(g, _m(0.01 * k, feet=(100.0, 100.0)), CFG)
+    expected = 100.0 * (1.0 - math.exp(-0.1 / CFG.force_filter_time_constant_s))
+    assert g.foot_fz_N[0] == pytest.approx(expected)
+
+
+# --- The seat's unloading plan -----------------------------------------------------------
+
+
+def test_seat_unloading_plan():
+    cfg = CFG
+    assert np.isnan(seat_unloading(_in_state(1, 0.0), 1.0, cfg)).all()
+    mode = _in_state(2, 3.0)
+    half = 3.0 + cfg.seat_unload_s / 2
+    np.testing.assert_allclose(seat_unloading(mode, 3.0, cfg)[0], 1.0)
+    np.testing.assert_allclose(seat_unloading(mode, half, cfg)[0], 0.5)  # smoothstep
+    assert seat_unloading(mode, 3.0 + cfg.seat_unload_s, cfg)[0] == 0.0
+    assert np.isnan(seat_unloading(mode, 4.0, cfg)[1:]).all()  # thighs still seated
+    mode = _in_state(3, 5.0)
+    quarter = 5.0 + cfg.seat_release_s / 4  # seat_scale 0.75
+    np.testing.assert_allclose(seat_unloading(mode, quarter, cfg)[1:], 0.75**2 * 1.5)
+    np.testing.assert_allclose(seat_unloading(mode, 5.0 + cfg.seat_release_s, cfg), 0.0)
+
+
+def test_3_to_4_waits_for_the_release():
+    cfg = dataclasses.replace(CFG, min_time_state3_s=0.0, seat_release_s=0.8)
+    mode = _in_state(3, 5.0, cfg)
+    assert _next(mode, _m(5.79, psi=20.0), cfg).state == 3
+    assert _next(mode, _m(5.801, psi=20.0), cfg).state == 4
+
+
+def test_state_3_starts_at_the_com_height():
+    """Bumpless: the state-3 segment starts at the measured CoM height (x, y continue
+    the state-2 segment), and state 4 rises from there to the standing height."""
+    mode = _in_state(2, 3.0)
+    com = np.array([0.3, 0.01, 0.355])
+    new = _next(mode, _m(3.0 + CFG.min_time_state2_s, com=com, feet=(200.0, 200.0)))
+    assert new.state == 3
+    assert new.x_start_m[2] == pytest.approx(0.355)
+    np.testing.assert_allclose(new.x_start_m[:2], mode.segment_end()[:2])

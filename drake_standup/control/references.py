@@ -289,8 +289,7 @@ class ReferenceGenerator:
         stance = 0.0
         if state.stance:
             stance = _smoothstep(
-                (path_progress - config.stance_from_progress)
-                / (1.0 - config.stance_from_progress)
+                (path_progress - config.stance_from_progress) / (1.0 - config.stance_from_progress)
             )
             vertical_weight_scale -= stance * (1.0 - config.stance_vertical_weight_scale)
         tau_hand = None
