@@ -226,6 +226,8 @@ class ControllerConfig:
     # drove the knees onto their stop, and the soles slid (measured).
     stance_from_progress: float = 0.7
     stance_vertical_weight_scale: float = 0.1
+    # Integral gain on the CoM height error in the stance (control/references.py). 1/s^3.
+    stance_height_ki_per_s3: float = 100.0
     # Standup states in which the CoM target leans against the hands' pull so that the
     # feet's CoP stays where it is without the pull (control/references.py: static_lean):
     # standing, a 15 + 15 N pull per hand needed the CoP past the toes (measured).
@@ -345,6 +347,7 @@ class ControllerTick:
     helpful_force_W: np.ndarray  # f_par, N
     posture: np.ndarray  # next value of the posture state (see __init__)
     lean_W: np.ndarray  # next value of the lean state, m
+    height_integral: float  # next value of the stance's height integral, m s
     unloading: np.ndarray  # next value of the unloading memory (see __init__)
     inputs_s: float  # evaluating the input ports (and the upstream systems behind them)
     kinematics_s: float
@@ -458,6 +461,7 @@ class WholeBodyController(LeafSystem):
         # [latched flag, state-1 posture (nu), filtered posture reference (nu), base yaw].
         self._posture = self.DeclareDiscreteState(2 + 2 * nu)
         self._lean = self.DeclareDiscreteState(3)  # the CoM target's lean, m
+        self._height_integral = self.DeclareDiscreteState(1)  # stance, int (z_d - z), m s
         # Unloading memory of the seat and thighs: [the commanded loads their unloading
         # started from (3), their last commanded loads (3)], N.
         self._unloading = self.DeclareDiscreteState(6)
@@ -512,6 +516,7 @@ class WholeBodyController(LeafSystem):
             state.get_value(self._posture),
             state.get_value(self._lean),
             progress,
+            float(state.get_value(self._height_integral)[0]),
         )
         unloading = self._next_unloading(state.get_value(self._unloading), plan)
         measured = (
@@ -534,6 +539,7 @@ class WholeBodyController(LeafSystem):
             helpful_force_W=references.helpful_force_W,
             posture=references.next_posture,
             lean_W=references.lean_W,
+            height_integral=references.next_height_integral,
             unloading=unloading,
             inputs_s=t_inputs - t_start,
             kinematics_s=t_kinematics - t_inputs,
@@ -699,6 +705,7 @@ class WholeBodyController(LeafSystem):
         discrete_state.set_value(self._momentum_integral, integral)
         discrete_state.set_value(self._posture, tick.posture)
         discrete_state.set_value(self._lean, tick.lean_W)
+        discrete_state.set_value(self._height_integral, [tick.height_integral])
         discrete_state.set_value(self._unloading, tick.unloading)
         total_s = time.perf_counter() - t_start
         diagnostics = np.empty(len(self.DIAGNOSTICS))

@@ -51,6 +51,7 @@ def _references(standup_state: int) -> TaskReferences:
         lean_W=np.zeros(3),
         vertical_weight_scale=1.0,
         stance=0.0,
+        next_height_integral=0.0,
         next_posture=None,
     )
 
