@@ -222,13 +222,14 @@ class StandupConfig:
     state2_com_delta_m: list[float] = field(default_factory=lambda: [0.1277, 0.0, 0.0])
     # CoM displacement of state 3 (SPEC 3). m.
     state3_com_delta_m: list[float] = field(default_factory=lambda: [0.04, 0.0, 0.0])
-    # State 4's CoM path rises to this absolute height; the legs' state-4
-    # posture then straightens the knees to the erect stance (~0.58 m, knees
-    # -0.17 rad; controller.stance_*). A path to the erect height itself drove
-    # the knees onto their stop at the end of a fast, pulled rise: near
-    # straight legs 1 cm of CoM is 0.3 rad of knee (measured). 0.526 m (SPEC 7's
-    # probe) left the robot in a crouch. m.
-    standing_com_height_m: float = 0.57
+    # State 4's CoM path rises to this absolute height: the erect height, the
+    # CoM of the authors' state-4 posture with the soles flat on the floor
+    # (scene.erect_com_height_m: 0.5753 m on iCubGazeboV2_5, tested). Over the
+    # path's last 30 % the legs' posture takes over (controller.stance_*): near
+    # straight legs 1 cm of CoM is 0.3 rad of knee, and a CoM target alone drove
+    # the knees onto their stop (measured). 0.526 m (SPEC 7's probe) left the
+    # robot in a crouch (knees -1.09 rad). m.
+    standing_com_height_m: float = 0.575
     # 2 -> 3: feet carry this much together (SPEC 3)... N
     feet_force_2to3_N: float = 150.0
     # ... after at least this long in state 2. The authors' 1.5 s (SPEC 3) equals

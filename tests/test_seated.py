@@ -99,3 +99,25 @@ def test_psi_equals_time_with_advancement_disabled():
     result = simulate(scenario, None, record=False, progress=False)
     assert result.metrics["psi_final"] == pytest.approx(1.5, abs=1e-9)
     assert result.metrics["psi_dot_min"] == 1.0 and result.metrics["psi_dot_max"] == 1.0
+
+
+def test_the_default_standing_height_is_the_erect_posture():
+    """standup.standing_com_height_m is the CoM height of the authors' state-4 posture
+    with the soles flat (forward kinematics), and that posture has flat soles: the
+    sagittal leg angles sum to zero, so each sole's z axis is vertical."""
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_standup.config import Scenario
+    from drake_standup.scene import add_scene, erect_com_height_m
+
+    scenario = Scenario()
+    scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
+    posture = scenario.controller.posture_state4_rad
+    for side in "lr":
+        legs = [posture[f"{side}_{joint}"] for joint in ("hip_pitch", "knee", "ankle_pitch")]
+        assert abs(sum(legs)) < 1e-9
+    height = erect_com_height_m(scene, scenario, posture)
+    assert scenario.standup.standing_com_height_m == pytest.approx(height, abs=1e-3)
+    # Straighter knees stand higher; a crouch lower (monotone in the knee).
+    straighter = dict(posture, l_knee=-0.05, r_knee=-0.05, l_hip_pitch=0.05, r_hip_pitch=0.05)
+    assert erect_com_height_m(scene, scenario, straighter) > height
