@@ -557,37 +557,27 @@ class WholeBodyController(LeafSystem):
             ]
             contact_map = ContactMap(contacts, self._nv)
             layout = contact_map.layout
+            joints = self._joints
+
+            def posture(kind, weights, name="posture", states=None):
+                return kind(
+                    layout,
+                    joints.q_indices,
+                    joints.v_indices,
+                    weights,
+                    config.posture_kp_per_s2,
+                    config.posture_damping_ratio,
+                    name=name,
+                    active_states=None if states is None else frozenset(states),
+                )
             tasks = [
                 MomentumTask(layout, contact_map, self._W_gravity, config.momentum_weight),
                 CopCenteringTask(layout, contacts, config.cop_centering_weight),
-                PostureTask(
-                    layout,
-                    self._joints.q_indices,
-                    self._joints.v_indices,
-                    self._posture_weights,
-                    config.posture_kp_per_s2,
-                    config.posture_damping_ratio,
-                ),
-                PostureTask(
-                    layout,
-                    self._joints.q_indices,
-                    self._joints.v_indices,
-                    self._stance_weights,
-                    config.posture_kp_per_s2,
-                    config.posture_damping_ratio,
-                    name="stance_posture",
-                    active_states=frozenset({4}),
-                ),
-                StancePostureTask(
-                    layout,
-                    self._joints.q_indices,
-                    self._joints.v_indices,
-                    self._stance_arm_weights,
-                    config.posture_kp_per_s2,
-                    config.posture_damping_ratio,
-                    name="stance_arms",
-                    active_states=frozenset({4}),
-                ),
+                posture(PostureTask, self._posture_weights),
+                # State 4: the legs (and the arms a little) from its start; the arms
+                # more as the stance grows (ControllerConfig.stance_*).
+                posture(PostureTask, self._stance_weights, "stance_posture", {4}),
+                posture(StancePostureTask, self._stance_arm_weights, "stance_arms", {4}),
                 BaseOrientationTask(
                     layout,
                     config.base_orientation_weight,
