@@ -13,7 +13,7 @@ from pathlib import Path
 import icub_models
 import pytest
 
-from drake_standup.config import Scenario, ScenarioError, load_scenario
+from drake_standup.config import Scenario, ScenarioError, load_scenario, parse_scenario
 
 REPO = Path(__file__).resolve().parent.parent
 SEATED = REPO / "scenarios" / "seated.yaml"
@@ -145,3 +145,12 @@ def test_controller_period_on_the_plant_grid_is_accepted(tmp_path, time_step, pe
     path.write_text(f"plant:\n  time_step: {time_step}\ncontroller_period_s: {period}\n")
     scenario = load_scenario(path)
     assert (scenario.plant.time_step, scenario.controller_period_s) == (time_step, period)
+
+
+def test_the_readme_scenario_example_parses():
+    """The README's list of public keys is a valid scenario (keeps the README true)."""
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    example = text[text.index("## Scenarios") :].split("```yaml\n", 1)[1].split("```", 1)[0]
+    scenario = parse_scenario(example)
+    assert scenario.standup.standing_com_height_m == 0.575
+    assert scenario.human.reactive.guide == "path"
