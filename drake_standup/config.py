@@ -214,6 +214,12 @@ class StandupConfig:
     balance_time_s: float = 3.0
     # x component of the force on each hand that starts the stand-up. N.
     hand_force_threshold_N: float = 10.0
+    # Both hands together pulled backwards by more than this (filtered, with the
+    # guards' hysteresis and dwell): the stand-up waits. Seated it does not start;
+    # in state 2 (the thighs still on the chair) it sits back into state 1; in
+    # state 3 it holds. psi = t meanwhile (the pull does not help). Issue 13:
+    # 10 N backwards per hand toppled the robot over the chair. N.
+    hindering_force_threshold_N: float = 8.0
     # Min-jerk segment lengths of states 2, 3, 4 in units of psi (= s when
     # psi = t); the advancement version's [1.5, 0.5, 1.8] (SPEC 3).
     segment_psi: list[float] = field(default_factory=lambda: [1.5, 0.5, 1.8])
@@ -775,6 +781,7 @@ def _validate_standup(st: StandupConfig) -> None:
     for name in (
         "balance_time_s",
         "hand_force_threshold_N",
+        "hindering_force_threshold_N",
         "feet_force_2to3_N",
         "min_time_state2_s",
         "foot_force_3to4_N",

@@ -162,6 +162,7 @@ def build_diagram(
         "alpha": advancement.GetOutputPort("alpha"),
         "com_reference": reference.GetOutputPort("com_reference"),
         "standup_state": state_machine.GetOutputPort("standup_state"),
+        "held_back": state_machine.GetOutputPort("held_back"),
         "segment": state_machine.GetOutputPort("segment"),
         "net_actuation": plant.get_net_actuation_output_port(instance),
     }

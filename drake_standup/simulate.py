@@ -265,11 +265,16 @@ def _simulate_one(
     sim_time_s = root_context.get_time()
     standing = result.metrics.get("standing_at_end", False)
     if failure_reason is None and built.controller is not None and not standing:
-        failure_reason = (
-            "did not stand up"
-            if result.metrics.get("standup_time_s") is None
-            else "stood up but was not standing at the end"
-        )
+        if result.metrics.get("held_back_s", 0.0) > 0.0 and result.metrics.get(
+            "standup_time_s"
+        ) is None:
+            failure_reason = "held back: hindering pull"
+        else:
+            failure_reason = (
+                "did not stand up"
+                if result.metrics.get("standup_time_s") is None
+                else "stood up but was not standing at the end"
+            )
     result.metrics.update(
         success=failure_reason is None,
         failure_reason=failure_reason,
@@ -432,6 +437,10 @@ def make_signals(built: StandupDiagram, root_context) -> dict[str, np.ndarray]:
         signals["commanded_normal_force_N"] = diagnostics[:, 4:9]
     if "push_force_W" in logs:
         signals["push_force_W"] = rows("push_force_W")
+    if "held_back" in logs:
+        held = rows("held_back")
+        signals["hindered"] = held[:, 0] > 0.5
+        signals["held_back_s"] = held[:, 1]
     return signals
 
 
@@ -472,6 +481,9 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
         metrics["joint_limit_slack_integral"] = float(
             np.sum(slack) * (signals["time_s"][1] - signals["time_s"][0]) if len(slack) > 1 else 0.0
         )
+    if "held_back_s" in signals and len(signals["time_s"]):
+        # How long the stand-up waited for a pull against it to stop (state machine).
+        metrics["held_back_s"] = float(signals["held_back_s"][-1])
     torques = signals["joint_torques_Nm"]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
     result.metrics = metrics

@@ -39,7 +39,7 @@ from pydrake.common.value import Value
 from pydrake.systems.framework import BasicVector, Context, LeafSystem, State
 
 from drake_standup.config import StandupConfig
-from drake_standup.reference import SEGMENT_SIZE
+from drake_standup.reference import SEGMENT_SIZE, path
 
 N_STATES = 4
 
@@ -76,6 +76,9 @@ class GuardSignals:
     hands_pulled: SchmittTrigger = SchmittTrigger()  # both hands > hand threshold
     feet_loaded: SchmittTrigger = SchmittTrigger()  # the feet together > feet_force_2to3_N
     each_foot_loaded: SchmittTrigger = SchmittTrigger()  # each foot > foot_force_3to4_N
+    # Both hands together pulled backwards (against the stand-up) by more than
+    # hindering_force_threshold_N.
+    hindered: SchmittTrigger = SchmittTrigger()
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,7 @@ class StandupMode:
     x_start_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     delta_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     guards: GuardSignals = GuardSignals()
+    held_back_s: float = 0.0  # time spent waiting for a hindering pull to stop
 
     def __copy__(self) -> StandupMode:
         return self
@@ -141,10 +145,11 @@ def update_guards(g: GuardSignals, m: Measurements, cfg: StandupConfig) -> Guard
         feet = _low_pass(g.foot_fz_N, m.foot_fz_N, gain)
         hands = _low_pass(g.hand_fx_N, m.hand_fx_N, gain)
     off, dwell = cfg.guard_off_ratio, cfg.guard_dwell_s
-    hand_on, feet_on, foot_on = (
+    hand_on, feet_on, foot_on, back_on = (
         cfg.hand_force_threshold_N,
         cfg.feet_force_2to3_N,
         cfg.foot_force_3to4_N,
+        cfg.hindering_force_threshold_N,
     )
     return GuardSignals(
         t=m.t,
@@ -153,6 +158,7 @@ def update_guards(g: GuardSignals, m: Measurements, cfg: StandupConfig) -> Guard
         hands_pulled=g.hands_pulled.update(min(hands), m.t, hand_on, off * hand_on, dwell),
         feet_loaded=g.feet_loaded.update(sum(feet), m.t, feet_on, off * feet_on, dwell),
         each_foot_loaded=g.each_foot_loaded.update(min(feet), m.t, foot_on, off * foot_on, dwell),
+        hindered=g.hindered.update(-sum(hands), m.t, back_on, off * back_on, dwell),
     )
 
 
@@ -160,11 +166,18 @@ def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> Standup
     """The mode after one update: its guards' signals updated, in the same or the next
     state."""
     g = update_guards(mode.guards, m, cfg)
-    mode = dataclasses.replace(mode, guards=g)
+    held = mode.held_back_s
+    if g.hindered.on and mode.state < 4 and not math.isnan(mode.guards.t):
+        held += m.t - mode.guards.t
+    mode = dataclasses.replace(mode, guards=g, held_back_s=held)
     dwell = m.t - mode.entry_times_s[mode.state - 1]
     segment_done = m.psi - mode.psi_entry >= mode.segment_psi
+    hindered = g.hindered.on
+    if mode.state == 2 and hindered:
+        return _reseat(mode, m)
     if mode.state == 1:
         go = dwell >= cfg.balance_time_s and (cfg.trigger == "time" or g.hands_pulled.on)
+        go = go and not hindered
     elif mode.state == 2:
         go = (
             dwell >= cfg.min_time_state2_s
@@ -178,12 +191,32 @@ def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> Standup
             and dwell >= cfg.seat_release_s  # the thighs unloaded
             and segment_done
             and g.each_foot_loaded.on
+            and not hindered
         )
     else:
         go = False
     if not go:
         return mode
     return _enter(mode, mode.state + 1, m, cfg)
+
+
+def _reseat(mode: StandupMode, m: Measurements) -> StandupMode:
+    """Back to state 1 from state 2 (the thighs are still on the chair): a pull against
+    the stand-up waits seated (the paper: psi = t, nothing advances). The state-1
+    segment holds the reference where it is now (no jump); state 1's balancing time
+    runs again from now."""
+    x_now = path(mode.segment(), m.psi)[0]
+    entry = [m.t] + [math.nan] * (N_STATES - 1)
+    return dataclasses.replace(
+        mode,
+        state=1,
+        entry_times_s=tuple(entry),
+        psi_entry=m.psi,
+        segment_psi=1.0,
+        x_start_m=tuple(float(v) for v in x_now),
+        delta_m=(0.0, 0.0, 0.0),
+        held_back_s=mode.held_back_s,
+    )
 
 
 def _enter(mode: StandupMode, state: int, m: Measurements, cfg: StandupConfig) -> StandupMode:
@@ -256,7 +289,8 @@ class StandupStateMachine(LeafSystem):
     Outputs: standup_state (1), segment (8: [psi_entry, T, x_start, delta]),
     contact_plan (6: [state, seat_scale, feet_scale, then what is left of the
     load of the seat, left thigh, right thigh (seat_unloading; NaN: seated)]),
-    entry_times_s (4, NaN for states not reached).
+    entry_times_s (4, NaN for states not reached), held_back (2: [a pull against
+    the stand-up holds it (1/0), the time it has waited so far, s]).
     """
 
     PLAN_SIZE = 6
@@ -291,6 +325,10 @@ class StandupStateMachine(LeafSystem):
         )
         self.DeclareVectorOutputPort(
             "entry_times_s", N_STATES, self._CalcEntryTimes, prerequisites_of_calc=mode_only
+        )
+        # [hindered (1/0), time held back so far, s]
+        self.DeclareVectorOutputPort(
+            "held_back", 2, self._CalcHeldBack, prerequisites_of_calc=mode_only
         )
 
     def mode(self, context: Context) -> StandupMode:
@@ -335,6 +373,10 @@ class StandupStateMachine(LeafSystem):
                 mode.state, seat_scale(mode, t, self._cfg), 1.0, seat_unloading(mode, t, self._cfg)
             ]
         )
+
+    def _CalcHeldBack(self, context: Context, output: BasicVector) -> None:
+        mode = self.mode(context)
+        output.SetFromVector([float(mode.guards.hindered.on), mode.held_back_s])
 
     def _CalcEntryTimes(self, context: Context, output: BasicVector) -> None:
         output.SetFromVector(np.array(self.mode(context).entry_times_s))

@@ -83,6 +83,7 @@ DEFAULT_SYSTEMS = {
         "com_reference",
         "controller_diagnostics",
         "hand_wrenches_W",
+        "held_back",
         "net_actuation",
         "pad_forces_W",
         "psi",

@@ -105,6 +105,21 @@ def test_reactive_helper_stands_up_sooner_and_lets_go(reactive, unassisted):
     assert np.all(nobody[standing])
 
 
+def test_a_hindering_pull_waits_seated_and_the_robot_stands_up_once_it_stops():
+    """Issue 13: 10 N backwards on each hand from 3 s to 11 s. The stand-up starts at 3 s,
+    sits back when the pull is felt, waits seated while it lasts (psi = t), and stands up
+    erect once it stops; no fall, no QP failure."""
+    scenario, m = _run("hindering")
+    assert m["success"], m["failure_reason"]
+    assert m["qp_failures"] == 0
+    assert m["psi_dot_min"] == 1.0 and m["psi_dot_max"] == 1.0
+    pull = scenario.human.pulls[0]
+    end_of_pull = pull.start_s + pull.duration_s
+    assert m["held_back_s"] > 0.8 * pull.duration_s
+    assert m["state_entry_times_s"][1] >= end_of_pull - pull.ramp_s  # restarted after it
+    assert m["com_final_m"][2] == pytest.approx(m["standing_com_height_m"], abs=0.01)
+
+
 @pytest.mark.parametrize("name", ["hindering", "lateral"])
 def test_unhelpful_pulls_never_advance_and_end_cleanly(name):
     scenario, m = _run(name)

@@ -288,3 +288,55 @@ def test_state_3_starts_at_the_com_height():
     assert new.state == 3
     assert new.x_start_m[2] == pytest.approx(0.355)
     np.testing.assert_allclose(new.x_start_m[:2], mode.segment_end()[:2])
+
+
+# --- Issue 13: a pull against the stand-up holds it ------------------------------------
+
+BACK = CFG.hindering_force_threshold_N  # both hands together, backwards
+
+
+def test_a_backward_pull_keeps_the_robot_seated():
+    cfg = dataclasses.replace(CFG, trigger="time")
+    mode = initial_mode(COM0)
+    back = (-(BACK / 2 + 1.0), -(BACK / 2 + 1.0))
+    assert _next(mode, _m(3.5, hands=back), cfg).state == 1
+    # Just below the threshold it does not count as hindering.
+    weak = (-(BACK / 2 - 0.5), -(BACK / 2 - 0.5))
+    assert _next(mode, _m(3.5, hands=weak), cfg).state == 2
+
+
+def test_a_backward_pull_in_state_2_sits_back_without_a_reference_jump():
+    """Back to state 1, the reference held where the state-2 segment had brought it
+    (the path evaluated independently here), the balancing time running again."""
+    mode = _in_state(2, 3.0)
+    psi = 3.6
+    m = _m(3.6, psi=psi, hands=(-10.0, -10.0))
+    new = _next(mode, m)
+    assert new.state == 1 and new.entry_times_s[0] == 3.6
+    assert math.isnan(new.entry_times_s[1])
+    tau = (psi - mode.psi_entry) / mode.segment_psi
+    s = 10 * tau**3 - 15 * tau**4 + 6 * tau**5
+    expected = np.array(mode.x_start_m) + s * np.array(mode.delta_m)
+    np.testing.assert_allclose(new.x_start_m, expected, atol=1e-12)
+    assert new.delta_m == (0.0, 0.0, 0.0)
+
+
+def test_state_3_holds_while_hindered_and_goes_on_when_the_pull_stops():
+    mode = _in_state(3, 5.0)
+    t_ok = 5.0 + max(CFG.min_time_state3_s, CFG.seat_release_s)
+    feet = (500.0, 500.0)
+    assert _next(mode, _m(t_ok, feet=feet, hands=(-10.0, -10.0))).state == 3
+    assert _next(mode, _m(t_ok, feet=feet, hands=(0.0, 0.0))).state == 4
+
+
+def test_time_held_back_accumulates_while_hindered():
+    cfg = dataclasses.replace(CFG, trigger="time")
+    mode = initial_mode(COM0)
+    t = 0.0
+    for k in range(400):  # 4 s of updates every 10 ms: pulled back from 1 to 3 s
+        t = 0.01 * k
+        hands = (-10.0, -10.0) if 1.0 <= t < 3.0 else (0.0, 0.0)
+        mode = next_mode(mode, _m(t, hands=hands, com=COM0), cfg)
+    # On after the filter and the dwell, off likewise: about 2 s in all.
+    assert mode.held_back_s == pytest.approx(2.0, abs=0.1)
+    assert not mode.guards.hindered.on
