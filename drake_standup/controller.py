@@ -14,7 +14,7 @@ Ports
                                  seated)]
     hand_wrenches_W  (12)       [tau_l, f_l, tau_r, f_r], world, at the hand frames' origins
     -> actuation     (nu)       joint torques, actuator order, N m (zero-order held)
-    -> diagnostics   (13)       see DIAGNOSTICS
+    -> diagnostics   (14)       see DIAGNOSTICS
 
 Contacts: the seat (a 6-D contact on root_link under the buttocks), both thighs (point
 forces on the thigh pads) and both soles (6-D). The seat and soles are held by the QP
@@ -376,6 +376,7 @@ class WholeBodyController(LeafSystem):
         "joint_limit_slack",  # largest slack of the soft joint-limit bounds, rad/s^2
         "lean_x_m",  # the CoM target's lean against the pull, x
         "lean_y_m",  # ... and y, m
+        "qp_relaxed",  # ticks solved only with the contacts relaxed, since the start
     )
     # Columns of timing_s().
     TIMING = ("inputs_s", "kinematics_s", "assembly_s", "solve_s", "total_s")
@@ -570,6 +571,7 @@ class WholeBodyController(LeafSystem):
                     name=name,
                     active_states=None if states is None else frozenset(states),
                 )
+
             tasks = [
                 MomentumTask(layout, contact_map, self._W_gravity, config.momentum_weight),
                 CopCenteringTask(layout, contacts, config.cop_centering_weight),
@@ -705,6 +707,7 @@ class WholeBodyController(LeafSystem):
         diagnostics[9] = math.sqrt(float(f_par @ f_par))
         diagnostics[10] = float(np.abs(solution.slack).max()) if solution.slack.size else 0.0
         diagnostics[11:13] = tick.lean_W[:2]
+        diagnostics[13] = state.get_value(self._diagnostics)[13] + float(solution.relaxed)
         discrete_state.set_value(self._diagnostics, diagnostics)
         self._timing.append(
             (tick.inputs_s, tick.kinematics_s, tick.assembly_s, solution.solve_s, total_s)

@@ -265,9 +265,10 @@ def _simulate_one(
     sim_time_s = root_context.get_time()
     standing = result.metrics.get("standing_at_end", False)
     if failure_reason is None and built.controller is not None and not standing:
-        if result.metrics.get("held_back_s", 0.0) > 0.0 and result.metrics.get(
-            "standup_time_s"
-        ) is None:
+        if (
+            result.metrics.get("held_back_s", 0.0) > 0.0
+            and result.metrics.get("standup_time_s") is None
+        ):
             failure_reason = "held back: hindering pull"
         else:
             failure_reason = (
@@ -430,6 +431,7 @@ def make_signals(built: StandupDiagram, root_context) -> dict[str, np.ndarray]:
         signals["qp_ok"] = diagnostics[:, 0] > 0.5
         signals["qp_failures"] = diagnostics[:, 1].astype(np.int64)
         signals["joint_limit_slack"] = diagnostics[:, 10]
+        signals["qp_relaxed"] = diagnostics[:, 13].astype(np.int64)
         signals["com_lean_W"] = np.c_[diagnostics[:, 11:13], np.zeros(len(t))]
         # What the QP asked of each of its contacts (NaN where it failed): against
         # pad_normal_force_N it shows where the controller's contact model is wrong.
@@ -481,6 +483,9 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
         metrics["joint_limit_slack_integral"] = float(
             np.sum(slack) * (signals["time_s"][1] - signals["time_s"][0]) if len(slack) > 1 else 0.0
         )
+    if "qp_relaxed" in signals and len(signals["time_s"]):
+        # Ticks the QP was solved only with its contacts relaxed (control/qp.py).
+        metrics["qp_relaxed_ticks"] = int(signals["qp_relaxed"][-1])
     if "held_back_s" in signals and len(signals["time_s"]):
         # How long the stand-up waited for a pull against it to stop (state machine).
         metrics["held_back_s"] = float(signals["held_back_s"][-1])

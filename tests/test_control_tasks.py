@@ -206,9 +206,33 @@ def test_soft_bounds_keep_an_impossible_bound_feasible(seated):
     commands = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
     impossible = _FixedBounds([knee], [5.0], [100.0])
     hard = _qp(plant, specs, None, acceleration_bounds=impossible)
-    assert not hard.solve(terms, _references(2), commands).ok
+    # As a hard bound: infeasible with the contacts held; only the relaxed fallback (the
+    # held rows dropped) solves it.
+    assert hard.solve(terms, _references(2), commands).relaxed
     soft = _qp(plant, specs, None, soft_bounds=impossible, soft_bound_weight=1e3)
     solution = soft.solve(terms, _references(2), commands)
-    assert solution.ok
+    assert solution.ok and not solution.relaxed
     assert abs(solution.vdot[knee]) < 1e-6
     assert abs(solution.slack[0]) == pytest.approx(5.0, rel=1e-6)
+
+
+def test_an_infeasible_program_falls_back_to_the_relaxed_one(seated):
+    """Seated, a minimum normal force of 1 kN on every contact (three times the weight,
+    with the dynamics exact) cannot be met: the program is infeasible; the fallback drops
+    the minimum forces and the held contact rows and solves, flagged relaxed, with the
+    dynamics' base rows still exact and the torques within their limits."""
+    plant, specs, terms, _ = seated
+    nc = len(specs)
+    config = ControllerConfig()
+    impossible = ContactCommands(np.full(nc, 1000.0), np.full(nc, 2000.0), {})
+    solution = _qp(plant, specs, None).solve(terms, _references(2), impossible)
+    assert solution.ok and solution.relaxed
+    assert np.abs(solution.tau).max() <= config.torque_limit_Nm + 1e-6
+    # The floating base's rows of M vdot + h = J^T F hold (no actuation there).
+    contact_map = ContactMap(specs, plant.num_velocities())
+    generalized = contact_map(terms).T @ solution.F_C.reshape(-1)[contact_map.unknowns]
+    residual = terms.M[:6] @ solution.vdot + terms.h[:6] - generalized[:6]
+    np.testing.assert_allclose(residual, 0.0, atol=1e-6)
+    # A feasible program is not relaxed.
+    fine = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    assert not _qp(plant, specs, None).solve(terms, _references(2), fine).relaxed

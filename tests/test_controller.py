@@ -376,9 +376,10 @@ def test_contacts_cancel_all_but_the_helpful_pull(scene, moving):
 # --- Failure handling, solvers, interface ----------------------------------------------------
 
 
-def test_failed_qp_keeps_last_torques_and_counts(scene):
-    """An infeasible QP (minimum normal force above the seat's maximum) neither raises
-    nor changes the actuation; qp_ok drops to 0 and the failure count rises."""
+def _infeasible_ticks(scene, break_fallback: bool):
+    """Four ticks of a controller whose QP is infeasible (minimum normal force above the
+    seat's maximum), from a known last actuation; break_fallback: the relaxed re-solve
+    fails too. Returns (last, actuation, diagnostics)."""
     scene, x0 = scene
     plant, robot = scene.plant, scene.robot
     controller, context = _controller(scene, min_normal_force_N=500.0)
@@ -386,14 +387,36 @@ def test_failed_qp_keeps_last_torques_and_counts(scene):
     _fix_inputs(controller, context, x0, np.concatenate([com, np.zeros(6)]), [1, 1, 1])
     last = np.linspace(-1.0, 1.0, plant.num_actuators())
     context.get_mutable_discrete_state(0).SetFromVector(last)
+    if break_fallback:
+        # Build the program the ticks use, then make its fallback fail.
+        controller.CalcTick(context)
+        for program in controller._programs.values():
+            program.qp._solve_relaxed = lambda H, g: (np.full(len(g), np.nan), False)
     simulator = Simulator(controller, context)
     simulator.Initialize()  # the initialization update
     simulator.AdvanceTo(0.0025)  # periodic updates at 0, 1 and 2 ms
     actuation = controller.GetOutputPort("actuation").Eval(context)
-    np.testing.assert_array_equal(actuation, last)
     diagnostics = controller.GetOutputPort("diagnostics").Eval(context)
-    diagnostics = dict(zip(controller.DIAGNOSTICS, diagnostics, strict=True))
+    return last, actuation, dict(zip(controller.DIAGNOSTICS, diagnostics, strict=True))
+
+
+def test_an_infeasible_qp_falls_back_to_the_relaxed_program_and_counts(scene):
+    """The relaxed re-solve (no minimum normal force, no held contact rows) gives torques
+    within the limits; qp_ok stays 1, qp_relaxed counts the four ticks, no failure."""
+    last, actuation, diagnostics = _infeasible_ticks(scene, break_fallback=False)
+    assert not np.array_equal(actuation, last)
+    assert np.abs(actuation).max() <= ControllerConfig().torque_limit_Nm + 1e-6
+    assert diagnostics["qp_ok"] == 1.0 and diagnostics["qp_failures"] == 0.0
+    assert diagnostics["qp_relaxed"] == 4.0
+
+
+def test_a_failed_fallback_keeps_the_last_torques_and_counts(scene):
+    """If the relaxed re-solve fails too, nothing raises, the actuation keeps its last
+    value, qp_ok drops to 0 and the failure count rises."""
+    last, actuation, diagnostics = _infeasible_ticks(scene, break_fallback=True)
+    np.testing.assert_array_equal(actuation, last)
     assert diagnostics["qp_ok"] == 0.0 and diagnostics["qp_failures"] == 4.0
+    assert diagnostics["qp_relaxed"] == 0.0
 
 
 def _solve_with(scene, solvers, *, seed, **config):

@@ -131,6 +131,9 @@ class QpSolution:
     solve_s: float
     frame_rotations: Callable[[], np.ndarray]  # () -> the contact frames' R_WC (nc, 3, 3)
     slack: np.ndarray = field(default_factory=lambda: np.zeros(0))  # soft bounds' s
+    # Solved only with the contacts relaxed (WholeBodyQp._solve_relaxed): the torques are
+    # the best the program could do, not a command that keeps the contacts.
+    relaxed: bool = False
 
     @cached_property
     def F_W(self) -> np.ndarray:
@@ -323,6 +326,23 @@ class WholeBodyQp:
             for rows in (self._rows_tau.start, m)
         ]
 
+    def _solve_relaxed(self, H: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, bool]:
+        """The fallback when the program is infeasible (or the solver fails): the same
+        cost and torque limits, but no minimum normal force and no held contact
+        acceleration (contact forces stay in their cones). Feasible by construction: the
+        contact forces 0 and any torques within the limits satisfy the dynamics through
+        vdot = M^-1 (...). Solved on copies of the bounds, once per failure."""
+        A, lo, hi, equality, backend = self._programs[-1]
+        if backend is None:
+            backend = make_backend(self._solver, *A.shape[::-1])
+            self._programs[-1] = A, lo, hi, equality, backend
+        lo, hi, equality = lo.copy(), hi.copy(), equality.copy()
+        lo[self._normal] = 0.0
+        held = self._bounds(slice(0, len(self._lo_acc)))
+        lo[held], hi[held], equality[held] = -np.inf, np.inf, 0
+        z, ok = backend.solve(H, g, A, lo, hi, equality)
+        return z, ok and bool(np.isfinite(z).all())
+
     def _bounds(self, rows: slice) -> slice:
         """Entries of lo, hi (after the n simple bounds) that belong to rows of A."""
         n = self.n
@@ -435,8 +455,14 @@ class WholeBodyQp:
             tau -= r_actuated
             if not ok or np.abs(tau).max() <= self._torque_limit_Nm:
                 break
-        t_solved = time.perf_counter()
         ok = ok and bool(np.isfinite(z).all())
+        relaxed = False
+        if not ok:
+            z, ok = self._solve_relaxed(H, g)
+            tau = T @ z
+            tau -= r_actuated
+            relaxed = ok
+        t_solved = time.perf_counter()
         nc, nw = len(self.contacts), self.layout.n_wrench
         F_C = np.zeros((nc, WRENCH_SIZE))
         F_C.reshape(-1)[self.contact_map.unknowns] = z[:nw]
@@ -445,6 +471,7 @@ class WholeBodyQp:
             ok=ok,
             vdot=z[self.layout.vdot],
             slack=z[self._slack],
+            relaxed=relaxed,
             F_C=F_C,
             tau=tau,
             assembly_s=t_assembled - t_start,
