@@ -59,6 +59,18 @@ BAD = {
         "controller_period_s",
     ),
     "zero_integrator_step": ("simulator:\n  max_step_size: 0\n", "simulator.max_step_size"),
+    "taper_past_the_end": (
+        "advancement:\n  taper_from_progress: 1.5\n",
+        "advancement.taper_from_progress",
+    ),
+    "negative_alpha_full": (
+        "advancement:\n  alpha_full_mps2: -0.1\n",
+        "advancement.alpha_full_mps2",
+    ),
+    "negative_hindering_threshold": (
+        "standup:\n  hindering_force_threshold_N: -3.0\n",
+        "standup.hindering_force_threshold_N",
+    ),
 }
 
 
