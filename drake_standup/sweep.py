@@ -74,6 +74,8 @@ class Figure:
     bins: int = 6
     range: list[float] | None = None  # rate: the bins' span (default: the data's)
     title: str | None = None
+    # Vertical reference lines: [{x: value, label: text}], e.g. a bound from theory.
+    lines: list[dict] = field(default_factory=list)
 
 
 @dataclass
@@ -258,7 +260,19 @@ def _figure(i: int, entry) -> Figure:
     where = f"figures[{i}]"
     if not isinstance(entry, dict):
         raise SweepError(f"{where}: accepted: a mapping of kind, x, y, group, bins, title")
-    _known(where, entry, ("kind", "x", "y", "group", "bins", "range", "title"))
+    _known(where, entry, ("kind", "x", "y", "group", "bins", "range", "title", "lines"))
+    lines = entry.get("lines", [])
+    if not isinstance(lines, list) or not all(
+        isinstance(line, dict)
+        and set(line) == {"x", "label"}
+        and isinstance(line["x"], (int, float))
+        and not isinstance(line["x"], bool)
+        and isinstance(line["label"], str)
+        for line in lines
+    ):
+        raise SweepError(
+            f"{where}.lines: {lines!r}; accepted: a list of {{x: number, label: text}}"
+        )
     span = entry.get("range")
     if span is not None and not (
         isinstance(span, list)
@@ -283,6 +297,7 @@ def _figure(i: int, entry) -> Figure:
         bins=bins,
         range=span,
         title=entry.get("title"),
+        lines=lines,
     )
 
 
@@ -357,6 +372,7 @@ def expand(spec: SweepSpec) -> list[RunSpec]:
                     push_start_s=start,
                     push_duration_s=duration,
                     push_magnitude_N=magnitude,
+                    push_impulse_Ns=magnitude * duration,
                     push_azimuth_deg=azimuth,
                     push_elevation_deg=elevation,
                 )
@@ -783,6 +799,17 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
             ax.text(c, r + 0.02, f"n={n}", ha="center", fontsize=8)
         ax.set_ylim(0, 1.15)
         ax.set_ylabel(f"{fig.y} rate")
+    for k, line in enumerate(fig.lines):
+        ax.axvline(line["x"], color="tab:red", ls="--", lw=1.2)
+        ax.text(
+            line["x"],
+            0.98 - 0.07 * k,
+            f" {line['label']}",
+            transform=ax.get_xaxis_transform(),
+            color="tab:red",
+            fontsize=8,
+            va="top",
+        )
     ax.set_xlabel(fig.x)
     ax.set_title(fig.title or f"{fig.y} vs {fig.x}", fontsize=10)
     ax.grid(alpha=0.3)

@@ -112,6 +112,8 @@ def test_seeded_random_draws_are_reproducible_and_per_run(tmp_path):
         expected = p["push_magnitude_N"] * np.array([math.cos(az), math.sin(az), 0.0])
         np.testing.assert_allclose(push["force_N"], expected, atol=1e-12)
         assert 3 <= push["start_s"] <= 7 and push["duration_s"] == 0.2
+        # The impulse column: magnitude times duration, N s.
+        assert p["push_impulse_Ns"] == pytest.approx(p["push_magnitude_N"] * 0.2)
         assert p["hand_wrench_noise_N"] == 1.5
         assert dict(run.overrides)["perturbation.noise_seed"] >= 0
     # Distinct noise seeds per run, and mass draws spread like N(1, 0.05).
@@ -157,6 +159,10 @@ def test_seeded_random_draws_are_reproducible_and_per_run(tmp_path):
         (
             "base: scenarios/assisted.yaml\nfigures: [{kind: rate, x: a, y: b, range: [2, 1]}]\n",
             "figures[0].range: [2, 1]; accepted: [low, high]",
+        ),
+        (
+            "base: scenarios/assisted.yaml\nfigures: [{kind: rate, x: a, y: b, lines: [{x: 1}]}]\n",
+            "figures[0].lines: [{'x': 1}]; accepted: a list of {x: number, label: text}",
         ),
     ],
 )
@@ -320,3 +326,35 @@ def test_sweep_bench_runs_the_same_sweep_on_each_worker_count(tmp_path, capsys):
         assert (out / f"workers_{n}" / "results.csv").is_file()
     assert summary["workers"]["1"]["throughput_vs_first"] == 1.0
     assert summary["same_results_for_every_worker_count"] is True
+
+
+def test_a_rate_figure_draws_its_reference_lines(tmp_path):
+    """The lines of a figure end up on the axes, at their x (matplotlib's own record)."""
+    from unittest import mock
+
+    from drake_standup.sweep import Figure, draw_figure
+
+    records = [
+        {
+            "index": i,
+            "run_id": f"r{i}",
+            "params": {"push_impulse_Ns": 2.0 * i},
+            "metrics": {"success": i < 3},
+        }
+        for i in range(6)
+    ]
+    fig = Figure(
+        kind="rate",
+        x="push_impulse_Ns",
+        y="success",
+        bins=3,
+        lines=[{"x": 9.3, "label": "LIP, forward"}],
+    )
+    import matplotlib.axes
+
+    with mock.patch.object(
+        matplotlib.axes.Axes, "axvline", wraps=None, autospec=True, side_effect=None
+    ) as axvline:
+        path = draw_figure(fig, records, tmp_path)
+    assert path is not None and path.exists()
+    assert [call.args[1] for call in axvline.call_args_list] == [9.3]
