@@ -232,10 +232,18 @@ class ControllerConfig:
     # feet's CoP stays where it is without the pull (control/references.py: static_lean):
     # standing, a 15 + 15 N pull per hand needed the CoP past the toes (measured).
     lean_states: list[int] = field(default_factory=lambda: [3, 4])
-    # Time constant of the lean's first-order filter: the pull's moment, not its jitter. s.
-    lean_filter_time_constant_s: float = 0.3
-    # The lean's bound per axis (x, y). m.
-    lean_max_m: float = 0.15
+    # Time constant of the lean's first-order filter: the pull's moment, not its jitter,
+    # and a slow return when a helper lets go (at 0.3 s a robot leaning 6 cm into a
+    # 15 N per hand backward pull staggered at the release and fell, measured). s.
+    lean_filter_time_constant_s: float = 0.8
+    # Bounds of the lean: the CoM target stays over the soles' CoP box with ~1.7 cm to
+    # spare (from the standing CoM: 0.068 m to the toes, 0.082 m to the heels, 0.132 m
+    # sideways; foot_cop_x_m/_y_m), so that the robot still stands when the pull stops.
+    # Leaning past the toes, 8 cm into a backward pull, it fell when the helper let go
+    # (measured). A pull that needs more than this is beyond what the feet allow. m.
+    lean_max_forward_m: float = 0.05
+    lean_max_back_m: float = 0.065
+    lean_max_m: float = 0.11  # sideways
     # Extra posture weights per joint in state 4 (a second posture task, active there
     # only): near straight legs 1 cm of CoM height is 0.3 rad of knee, so the CoM target
     # alone cannot place the knees (measured); the legs' posture sets them.

@@ -120,6 +120,24 @@ def test_a_hindering_pull_waits_seated_and_the_robot_stands_up_once_it_stops():
     assert m["com_final_m"][2] == pytest.approx(m["standing_com_height_m"], abs=0.01)
 
 
+@pytest.mark.parametrize("start_s", [5.2, 8.0])
+def test_a_hindering_pull_on_the_rising_or_standing_robot_does_not_topple_it(start_s):
+    """Issue 13: 15 N backwards on each hand for 4 s, from inside state 4 (5.2 s) or on the
+    standing robot (8.0 s): it leans into the pull within its feet and stays standing
+    when the pull stops (before the lean was bounded by the feet it fell then)."""
+    from drake_standup.config import Pull
+
+    scenario = load_scenario(SCENARIO_DIR / "unassisted.yaml")
+    scenario.human.pulls = [
+        Pull(hand=hand, start_s=start_s, duration_s=4.0, ramp_s=0.3, force_N=[-15.0, 0.0, 0.0])
+        for hand in ("left", "right")
+    ]
+    m = simulate(scenario, None, record=False, progress=False).metrics
+    assert m["success"], m["failure_reason"]
+    assert m["psi_dot_max"] == 1.0
+    assert m["com_final_m"][2] == pytest.approx(m["standing_com_height_m"], abs=0.01)
+
+
 @pytest.mark.parametrize("name", ["hindering", "lateral"])
 def test_unhelpful_pulls_never_advance_and_end_cleanly(name):
     scenario, m = _run(name)

@@ -238,9 +238,10 @@ class ReferenceGenerator:
         F_hand_W: np.ndarray | None,
         lean_W: np.ndarray | None,
     ) -> np.ndarray:
-        """The lean's next value: static_lean of the measured pull, first-order filtered
-        (lean_filter_time_constant_s), in the states that stand on the feet alone; it
-        decays back to zero in the others and when the pull stops."""
+        """The lean's next value: static_lean of the measured pull, bounded forward and
+        back by the feet (lean_max_forward_m, lean_max_back_m; lean_max_m sideways),
+        first-order filtered (lean_filter_time_constant_s), in the states that stand on
+        the feet alone; it decays back to zero in the others and when the pull stops."""
         lean = np.zeros(3) if lean_W is None else lean_W
         target = np.zeros(3)
         if state.lean and F_hand_W is not None:
@@ -248,6 +249,9 @@ class ReferenceGenerator:
             wrench[:3] -= np.cross(terms.p_BoCom, wrench[3:])
             target = static_lean(
                 wrench, float(terms.p_WCom[2]), self._weight_N, self._config.lean_max_m
+            )
+            target[0] = min(
+                max(target[0], -self._config.lean_max_back_m), self._config.lean_max_forward_m
             )
         if not (target.any() or lean.any()):
             return lean
