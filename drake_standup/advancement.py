@@ -48,6 +48,7 @@ from pydrake.systems.framework import BasicVector, Context, ContinuousState, Lea
 
 from drake_standup.caching import declare_cached
 from drake_standup.config import AdvancementConfig
+from drake_standup.reference import smoothstep
 
 
 def helpfulness(tangent: np.ndarray, omega_f: np.ndarray, eps: float) -> float:
@@ -90,7 +91,7 @@ def psi_dot_law(
         )
     if progress > config.taper_from_progress:
         r = (progress - config.taper_from_progress) / (1.0 - config.taper_from_progress)
-        weight *= 1.0 - min(r, 1.0) ** 2 * (3.0 - 2.0 * min(r, 1.0))
+        weight *= 1.0 - smoothstep(r)
         if weight <= 0.0:
             return 1.0, alpha
     if config.lead_gate:

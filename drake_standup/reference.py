@@ -20,6 +20,13 @@ from drake_standup.caching import declare_cached
 SEGMENT_SIZE = 8  # [psi_entry, T, x_start (3), delta (3)]
 
 
+def smoothstep(r: float) -> float:
+    """3 r^2 - 2 r^3 on r clamped to [0, 1]: 0 -> 1 with zero slope at both ends (the
+    fades and ramps of the advancement, the controller and the seat's unloading)."""
+    r = min(max(r, 0.0), 1.0)
+    return r * r * (3.0 - 2.0 * r)
+
+
 def min_jerk(tau: float) -> tuple[float, float, float]:
     """s, ds/dtau, d2s/dtau2 of the min-jerk profile, clamped outside [0, 1]."""
     if tau <= 0.0:

@@ -39,7 +39,7 @@ from pydrake.common.value import Value
 from pydrake.systems.framework import BasicVector, Context, LeafSystem, State
 
 from drake_standup.config import StandupConfig
-from drake_standup.reference import SEGMENT_SIZE, path
+from drake_standup.reference import SEGMENT_SIZE, path, smoothstep
 
 N_STATES = 4
 
@@ -215,7 +215,6 @@ def _reseat(mode: StandupMode, m: Measurements) -> StandupMode:
         segment_psi=1.0,
         x_start_m=tuple(float(v) for v in x_now),
         delta_m=(0.0, 0.0, 0.0),
-        held_back_s=mode.held_back_s,
     )
 
 
@@ -259,11 +258,6 @@ def seat_scale(mode: StandupMode, t: float, cfg: StandupConfig) -> float:
     return max(0.0, 1.0 - (t - mode.entry_times_s[2]) / cfg.seat_release_s)
 
 
-def _smoothstep(r: float) -> float:
-    r = min(max(r, 0.0), 1.0)
-    return r * r * (3.0 - 2.0 * r)
-
-
 def seat_unloading(mode: StandupMode, t: float, cfg: StandupConfig) -> np.ndarray:
     """What is left of the load of the buttocks (seat contact) and of each thigh, as a
     fraction of their load when their unloading began; NaN while the pad is seated (the
@@ -275,9 +269,9 @@ def seat_unloading(mode: StandupMode, t: float, cfg: StandupConfig) -> np.ndarra
         if cfg.seat_unload_s <= 0:
             fractions[0] = 0.0
         else:
-            fractions[0] = _smoothstep(1.0 - (t - mode.entry_times_s[1]) / cfg.seat_unload_s)
+            fractions[0] = smoothstep(1.0 - (t - mode.entry_times_s[1]) / cfg.seat_unload_s)
     if mode.state >= 3:
-        fractions[1:] = _smoothstep(seat_scale(mode, t, cfg))
+        fractions[1:] = smoothstep(seat_scale(mode, t, cfg))
     return fractions
 
 

@@ -43,6 +43,7 @@ import numpy as np
 
 from drake_standup.control.spatial import yaw_pitch_rotation
 from drake_standup.control.terms import RobotTerms
+from drake_standup.reference import smoothstep
 
 if TYPE_CHECKING:
     from drake_standup.controller import ControllerConfig
@@ -65,11 +66,6 @@ def com_acceleration_reference(
     return xd_ddot - kd_per_s * (v_WCom - xd_dot) - kp_per_s2 * (p_WCom - x_d)
 
 
-def _smoothstep(r: float) -> float:
-    r = min(max(r, 0.0), 1.0)
-    return r * r * (3.0 - 2.0 * r)
-
-
 def helpful_force(
     f_hand_W: np.ndarray,
     xd_dot: np.ndarray,
@@ -87,7 +83,7 @@ def helpful_force(
     if speed == 0.0:
         return np.zeros(3)
     u = xd_dot / speed
-    fade = _smoothstep(speed / fade_speed_mps) * (1.0 - _smoothstep(lead_m / max_lead_m))
+    fade = smoothstep(speed / fade_speed_mps) * (1.0 - smoothstep(lead_m / max_lead_m))
     return fade * max(float(f_hand_W @ u), 0.0) * u
 
 
@@ -235,17 +231,20 @@ class ReferenceGenerator:
         self,
         terms: RobotTerms,
         state: StateReferences,
-        F_hand_W: np.ndarray | None,
+        tau_hand: np.ndarray | None,
         lean_W: np.ndarray | None,
     ) -> np.ndarray:
-        """The lean's next value: static_lean of the measured pull, bounded forward and
+        """tau_hand: the hands' generalized force J_h^T F_hand (None: no pull), whose first
+        six entries are their resultant about the base origin (control/terms.py).
+
+        The lean's next value: static_lean of the measured pull, bounded forward and
         back by the feet (lean_max_forward_m, lean_max_back_m; lean_max_m sideways),
         first-order filtered (lean_filter_time_constant_s), in the states that stand on
         the feet alone; it decays back to zero in the others and when the pull stops."""
         lean = np.zeros(3) if lean_W is None else lean_W
         target = np.zeros(3)
-        if state.lean and F_hand_W is not None:
-            wrench = terms.J_W.reshape(len(F_hand_W), -1).T[:6] @ F_hand_W
+        if state.lean and tau_hand is not None:
+            wrench = tau_hand[:6].copy()
             wrench[:3] -= np.cross(terms.p_BoCom, wrench[3:])
             target = static_lean(
                 wrench, float(terms.p_WCom[2]), self._weight_N, self._config.lean_max_m
@@ -277,7 +276,8 @@ class ReferenceGenerator:
         error before this tick, m s."""
         config = self._config
         state = self.schedule[standup_state]
-        lean = self._lean(terms, state, F_hand_W, lean_W)
+        tau_hand = None if F_hand_W is None else terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
+        lean = self._lean(terms, state, tau_hand, lean_W)
         if lean.any():
             # Leaning is tilting about the feet: the CoM target keeps its distance from
             # the floor point below the unleaned target, so it drops as it leans (2 cm at
@@ -296,7 +296,7 @@ class ReferenceGenerator:
         vertical_weight_scale = 1.0
         stance = 0.0
         if state.stance:
-            stance = _smoothstep(
+            stance = smoothstep(
                 (path_progress - config.stance_from_progress) / (1.0 - config.stance_from_progress)
             )
             vertical_weight_scale -= stance * (1.0 - config.stance_vertical_weight_scale)
@@ -307,7 +307,7 @@ class ReferenceGenerator:
         next_height_integral = 0.0
         if stance > 0.0:
             ki = config.stance_height_ki_per_s3
-            limit = 0.2 * 9.81 / ki
+            limit = 0.2 * (self._weight_N / terms.mass_kg) / ki  # 20 % of g, the plant's
             next_height_integral = min(
                 max(
                     height_integral
@@ -317,7 +317,6 @@ class ReferenceGenerator:
                 limit,
             )
             Ldot_star[5] += terms.mass_kg * ki * next_height_integral
-        tau_hand = None
         f_par = np.zeros(3)
         if F_hand_W is not None:
             xd_dot = com_reference[3:6]
@@ -334,7 +333,6 @@ class ReferenceGenerator:
             # the help carried the CoM onto straight, locked knees (measured).
             f_par *= 1.0 - stance
             Ldot_star[3:] += f_par
-            tau_hand = terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
 
         nu = self._nu
         if posture[0] > 0.5:
