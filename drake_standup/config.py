@@ -216,10 +216,21 @@ class StandupConfig:
     hand_force_threshold_N: float = 10.0
     # Both hands together pulled backwards by more than this (filtered, with the
     # guards' hysteresis and dwell): the stand-up waits. Seated it does not start;
-    # in state 2 (the thighs still on the chair) it sits back into state 1; in
-    # state 3 it holds. psi = t meanwhile (the pull does not help). Issue 13:
-    # 10 N backwards per hand toppled the robot over the chair. N.
+    # in state 2, or in state 3 while the thighs still carry most of their load
+    # (reseat_above_thigh_load), it sits back into state 1; later in state 3 it
+    # holds. psi = t meanwhile (the pull does not help). Issue 13: 10 N backwards
+    # per hand toppled the robot over the chair. N.
     hindering_force_threshold_N: float = 8.0
+    # Once a hindering pull has stopped, the stand-up waits this long before it
+    # (re)starts from state 1 or goes on from state 3: the pull is over, not
+    # paused, and the arms it swung back return to their posture first. s.
+    resume_after_s: float = 0.5
+    # In state 3 a hindering pull sits the robot back while the thighs' release
+    # has left them more than this fraction of their load (the plan's smoothstep);
+    # later state 3 holds. Sat back with the thighs at 0.4 of their load, the
+    # robot's feet were left unloaded on the chair and its next attempt fell back;
+    # holding there, it stood (measured, 15 N per hand).
+    reseat_above_thigh_load: float = 0.5
     # Min-jerk segment lengths of states 2, 3, 4 in units of psi (= s when
     # psi = t); the advancement version's [1.5, 0.5, 1.8] (SPEC 3).
     segment_psi: list[float] = field(default_factory=lambda: [1.5, 0.5, 1.8])
@@ -782,6 +793,7 @@ def _validate_standup(st: StandupConfig) -> None:
         "balance_time_s",
         "hand_force_threshold_N",
         "hindering_force_threshold_N",
+        "resume_after_s",
         "feet_force_2to3_N",
         "min_time_state2_s",
         "foot_force_3to4_N",
@@ -793,10 +805,10 @@ def _validate_standup(st: StandupConfig) -> None:
     ):
         _positive(f"standup.{name}", getattr(st, name), allow_zero=True)
     _positive("standup.standing_com_height_m", st.standing_com_height_m)
-    if not 0.0 <= st.guard_off_ratio <= 1.0:
-        raise ScenarioError(
-            f"standup.guard_off_ratio: {st.guard_off_ratio}; accepted: a number in [0, 1]"
-        )
+    for name in ("guard_off_ratio", "reseat_above_thigh_load"):
+        value = getattr(st, name)
+        if not 0.0 <= value <= 1.0:
+            raise ScenarioError(f"standup.{name}: {value}; accepted: a number in [0, 1]")
     _positive("standup.update_period_s", st.update_period_s)
 
 

@@ -263,7 +263,10 @@ def _simulate_one(
     if built.controller is not None:
         result.controller_timing_s = built.controller.timing_s()
     sim_time_s = root_context.get_time()
-    standing = result.metrics.get("standing_at_end", False)
+    # Success: standing at the end, having stood (standup_time_s: standing held 0.2 s).
+    standing = result.metrics.get("standing_at_end", False) and (
+        result.metrics.get("standup_time_s") is not None
+    )
     if failure_reason is None and built.controller is not None and not standing:
         if (
             result.metrics.get("held_back_s", 0.0) > 0.0
@@ -433,6 +436,8 @@ def make_signals(built: StandupDiagram, root_context) -> dict[str, np.ndarray]:
         signals["joint_limit_slack"] = diagnostics[:, 10]
         signals["qp_relaxed"] = diagnostics[:, 13].astype(np.int64)
         signals["com_lean_W"] = np.c_[diagnostics[:, 11:13], np.zeros(len(t))]
+        # The controller's model mass over the nominal, as it weighed the robot seated.
+        signals["model_mass_scale"] = diagnostics[:, 14]
         # What the QP asked of each of its contacts (NaN where it failed): against
         # pad_normal_force_N it shows where the controller's contact model is wrong.
         signals["commanded_contacts"] = np.array(WholeBodyController.CONTACTS, dtype=str)
@@ -486,6 +491,11 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
     if "qp_relaxed" in signals and len(signals["time_s"]):
         # Ticks the QP was solved only with its contacts relaxed (control/qp.py).
         metrics["qp_relaxed_ticks"] = int(signals["qp_relaxed"][-1])
+    if "model_mass_scale" in signals and len(signals["time_s"]):
+        # The robot's mass as the controller estimated it (weighing itself seated).
+        metrics["model_mass_kg"] = float(
+            signals["model_mass_scale"][-1] * built.controller.nominal_mass_kg
+        )
     if "held_back_s" in signals and len(signals["time_s"]):
         # How long the stand-up waited for a pull against it to stop (state machine).
         metrics["held_back_s"] = float(signals["held_back_s"][-1])

@@ -508,3 +508,33 @@ def test_ports_and_config(scene):
         _controller(scene, qp_solver="cplex")
     with pytest.raises(ValueError, match="posture_state2_rad"):
         _controller(scene, posture_state2_rad={"no_such_joint": 0.0})
+
+
+@pytest.mark.parametrize("scale", [0.85, 1.15])
+def test_scaled_model_terms_are_drakes_with_scaled_masses(scene, scale):
+    """RobotKinematics.set_mass_scale: M, h and the CoM equal Drake's own for a plant
+    context whose every robot body's mass is scaled (CoM and unit inertia kept)."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    context = plant.CreateDefaultContext()
+    for index in plant.GetBodyIndices(instance):
+        body = plant.get_body(index)
+        body.SetMass(context, scale * body.default_mass())
+    kinematics = RobotKinematics(plant, robot, held_frames=[], other_frames=[])
+    nominal = kinematics.mass_kg
+    kinematics.set_mass_scale(scale)
+    assert kinematics.mass_kg == pytest.approx(plant.CalcTotalMass(context, [instance]))
+    assert kinematics.mass_kg == pytest.approx(scale * nominal)
+    rng = np.random.default_rng(5)
+    for _ in range(4):
+        x = _random_state(plant, instance, x0, rng)
+        plant.SetPositionsAndVelocities(context, instance, x)
+        terms = kinematics.calc(x, [])
+        np.testing.assert_allclose(terms.M, plant.CalcMassMatrix(context), atol=1e-10)
+        h = plant.CalcBiasTerm(context) - plant.CalcGravityGeneralizedForces(context)
+        h += _joint_damping(plant, instance) * x[plant.num_positions() :]
+        np.testing.assert_allclose(terms.h, h, atol=1e-9)
+        np.testing.assert_allclose(
+            terms.p_WCom, plant.CalcCenterOfMassPositionInWorld(context, [instance]), atol=1e-12
+        )

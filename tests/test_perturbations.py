@@ -69,6 +69,7 @@ DEFAULT_SYSTEMS = {
     "com_reference",
     "contact_forces",
     "seat_pad_forces",
+    "pads_vertical_force",
     "controller",
     "human",
     "plant",
