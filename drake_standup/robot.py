@@ -44,9 +44,10 @@ from pydrake.multibody.tree import (
 )
 
 from drake_standup.meshes import cache_dir, converted_obj
+from drake_standup.resources import model_file
 
 DEFAULT_MODEL = "iCubGazeboV2_5"
-CONTACT_FILE = Path(__file__).resolve().parent.parent / "models" / "icub_contact.yaml"
+CONTACT_FILE = model_file("icub_contact.yaml")
 
 
 class ModelError(ValueError):
