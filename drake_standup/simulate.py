@@ -305,6 +305,10 @@ def _simulate_one(
         path = out_dir / "signals.npz"
         outputs.write_signals(path, result.signals)
         result.files["signals"] = path
+        # Every value simulated, as a scenario file (--scenario reruns it).
+        path = out_dir / "scenario.yaml"
+        path.write_text(yaml_dump_typed(scenario))
+        result.files["scenario"] = path
         # The figures draw the arrays signals.npz holds (the round trip is tested).
         entries = result.metrics.get("state_entry_times_s", [])
         path = out_dir / "figure_advancement.png"
