@@ -23,6 +23,7 @@ from pydrake.systems.analysis import SimulatorConfig
 from drake_standup.control.qp import SOLVERS
 from drake_standup.controller import ControllerConfig
 from drake_standup.resources import data_root, shipped
+from drake_standup.robot import EFFORT_LIMIT_NM
 
 SCENARIO_DIR = data_root() / "scenarios"
 DEFAULT_SCENARIO = SCENARIO_DIR / "assisted.yaml"
@@ -61,8 +62,8 @@ class RobotConfig:
     model: str = "iCubGazeboV2_5"
     # Replace massless sensor/skin links by frames (SPEC 5: 3-10x faster terms).
     reduced: bool = True
-    # Torque saturation of the authors' controller (SPEC 3), N m.
-    effort_limit_Nm: float = 60.0
+    # Every actuator's effort limit, which the controller reads from the plant. N m.
+    effort_limit_Nm: float = EFFORT_LIMIT_NM
     # Triangles per visual mesh after decimation. Meshcat's HTML is 2.2 MB of
     # viewer, ~0.15 MB per simulated second of animation, plus the meshes: at
     # 1000 faces they take ~1.3 MB and a 15 s recording stays under 8 MB.
@@ -759,6 +760,8 @@ def _nodes(data, steps: list | None = None) -> Iterator[tuple[str, object]]:
 
 
 def _check(key: str, value, accepted) -> None:
+    if value is None:  # an optional value left out
+        return
     if isinstance(value, float) and not math.isfinite(value):
         raise ScenarioError(f"{key}: {value} is not finite; accepted: a finite number")
     if isinstance(value, list) and isinstance(accepted, Range | tuple):

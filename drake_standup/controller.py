@@ -192,8 +192,9 @@ class ControllerConfig:
     # thighs (measured). m.
     seat_cop_x_m: list[float] = field(default_factory=lambda: [-0.11, -0.06])
     seat_cop_y_m: list[float] = field(default_factory=lambda: [-0.05, 0.05])
-    # Joint torque saturation (SPEC 3). N m.
-    torque_limit_Nm: float = 60.0
+    # Joint torque saturation, N m. None: the actuators' effort limit in the plant
+    # (robot.effort_limit_Nm, SPEC 3); a number: a tighter limit of the controller's own.
+    torque_limit_Nm: float | None = None
     # ||xd_dot|| below which the helpful part of the pull fades out (smoothstep): the
     # standing robot compensates the whole pull (SPEC 7). m/s.
     help_fade_speed_mps: float = 0.02
@@ -404,6 +405,10 @@ class WholeBodyController(LeafSystem):
         self._config = config
         self._period_s = period_s
         self._B = plant.MakeActuationMatrix()
+        actuators = plant.GetJointActuatorIndices(robot.model_instance)
+        self._torque_limit_Nm = config.torque_limit_Nm or min(
+            plant.get_joint_actuator(i).effort_limit() for i in actuators
+        )
         self._nv, self._nu = nv, nu = self._B.shape
         self.contact_specs = _contact_specs(plant, robot, config)
         held_frames = [spec.frame for spec in self.contact_specs if spec.constrained]
@@ -598,7 +603,7 @@ class WholeBodyController(LeafSystem):
             qp = WholeBodyQp(
                 contact_map,
                 self._B,
-                torque_limit_Nm=config.torque_limit_Nm,
+                torque_limit_Nm=self._torque_limit_Nm,
                 torque_weight=config.torque_weight,
                 wrench_weight=config.wrench_weight,
                 acceleration_weight=config.acceleration_weight,

@@ -31,8 +31,6 @@ from drake_standup.perturbations import apply_model_errors
 from drake_standup.progress import ProgressBar
 from drake_standup.scene import erect_com_height_m, set_seated_state
 
-GRAVITY_MPS2 = 9.81
-
 
 @dataclass
 class RunResult:
@@ -460,7 +458,8 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
     # one (perturbation.mass_scale), whose weight the contacts carry.
     mass_kg = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
     simulated_mass_kg = plant.CalcTotalMass(plant.GetMyContextFromRoot(root_context), [instance])
-    metrics = outputs.seated_metrics(signals, weight_N=simulated_mass_kg * GRAVITY_MPS2)
+    g = -plant.gravity_field().gravity_vector()[2]
+    metrics = outputs.seated_metrics(signals, weight_N=simulated_mass_kg * g)
     metrics["robot_mass_kg"] = mass_kg
     metrics["simulated_mass_kg"] = simulated_mass_kg
     entry_times = built.state_machine.mode(
