@@ -97,10 +97,27 @@ def run_parser(prog: str) -> OneLineErrorParser:
     return parser
 
 
+def parse_set(text: str) -> tuple[str, object]:
+    """--set's 'key.path=value' (the value in YAML: 2.0, time, [1, 0, 2]) -> (path, value)."""
+    import yaml
+
+    from drake_standup.config import ScenarioError
+
+    path, equals, value = text.partition("=")
+    try:
+        if equals and path.strip():
+            return path.strip(), yaml.safe_load(value)
+    except yaml.YAMLError:
+        pass
+    raise ScenarioError(
+        f"--set {text}: accepted: key.path=VALUE (YAML), e.g. advancement.eps=1.0e-4"
+    )
+
+
 def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> int:
     args = run_parser(prog).parse_args(argv)
 
-    from drake_standup.config import ScenarioError, load_scenario, parse_set
+    from drake_standup.config import ScenarioError, load_scenario
 
     try:
         overrides = [parse_set(text) for text in args.overrides]

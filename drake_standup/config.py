@@ -472,36 +472,12 @@ def apply_overrides(scenario: Scenario, overrides: Iterable) -> Scenario:
     return scenario
 
 
-def parse_set(text: str) -> tuple[str, object]:
-    """'key.path=value' (value in YAML: 2.0, time, [1, 0, 2]) -> (key path, value)."""
-    path, equals, value = text.partition("=")
-    if not equals or not path.strip():
-        raise ScenarioError(
-            f"--set {text}: accepted: key.path=value, e.g. advancement.psi_dot_upper=2.0"
-        )
-    try:
-        return path.strip(), yaml.safe_load(value)
-    except yaml.YAMLError as err:
-        raise ScenarioError(f"--set {text}: not a YAML value ({_one_line(err)})") from None
-
-
 def expand_key_path(scenario: Scenario, path: str) -> list[str]:
     """The concrete key paths a path names in scenario ([*]: every entry of a list)."""
-    found = [[]]
-    data = _plain(scenario)
-    for step in _parse_key_path(path):
-        wider = []
-        for done in found:
-            node = _node(data, done)
-            if step != "*":
-                _child(path, node, step, done)
-                wider.append(done + [step])
-            elif not isinstance(node, list):
-                raise ScenarioError(f"key path '{path}': {_format(done)} is not a list")
-            else:
-                wider += [done + [i] for i in range(len(node))]
-        found = wider
-    return [_format(steps) for steps in found]
+    if "[*]" not in path:
+        return [path]
+    pattern = _pattern(path)
+    return [key for key, _ in _nodes(_plain(scenario)) if pattern.fullmatch(key)]
 
 
 def chair_file(name: str) -> Path:
@@ -520,7 +496,8 @@ def _load(text: str, raw: dict, defaults: Scenario) -> Scenario:
     try:
         return yaml_load_typed(schema=Scenario, data=text, defaults=defaults)
     except (RuntimeError, ValueError, TypeError, AssertionError) as err:
-        for steps, value in _leaves(raw):
+        for key, value in _nodes(raw, leaves=True):
+            steps = _parse_key_path(key)
             try:
                 yaml_load_typed(schema=Scenario, data=yaml.safe_dump(_nest(steps, value)))
             except (RuntimeError, ValueError, TypeError, AssertionError):
@@ -569,19 +546,6 @@ def _fields(schema) -> dict[str, typing.Any] | None:
 def _plain(scenario: Scenario) -> dict:
     """scenario as plain YAML data (dicts, lists, numbers, strings)."""
     return yaml.safe_load(yaml_dump_typed(scenario))
-
-
-def _leaves(data, steps: list | None = None) -> Iterator[tuple[list, object]]:
-    """(key path steps, value) of every leaf of plain data; an empty list is a leaf."""
-    steps = steps or []
-    if isinstance(data, dict):
-        for key, value in data.items():
-            yield from _leaves(value, steps + [key])
-    elif isinstance(data, list) and data:
-        for i, value in enumerate(data):
-            yield from _leaves(value, steps + [i])
-    else:
-        yield steps, data
 
 
 def _nest(steps: list, value):
@@ -650,41 +614,32 @@ def _child(path: str, node, step: str | int, done: list, new_key_ok: bool = Fals
 
 @dataclass(frozen=True)
 class Range:
-    """Numbers from low to high; open ends excluded."""
+    """Numbers from low to high; an open end excluded."""
 
-    low: float = -math.inf
+    low: float = 0.0
     high: float = math.inf
     low_open: bool = False
     high_open: bool = False
 
-    def accepts(self, value) -> bool:
-        above = value > self.low if self.low_open else value >= self.low
-        return above and (value < self.high if self.high_open else value <= self.high)
+    def accepts(self, x) -> bool:
+        above = x > self.low if self.low_open else x >= self.low
+        return above and (x < self.high if self.high_open else x <= self.high)
 
     def __str__(self) -> str:
         if self.high == math.inf:
             return f"a number {'>' if self.low_open else '>='} {self.low:g}"
-        left, right = "(" if self.low_open else "[", ")" if self.high_open else "]"
+        left, right = "(["[not self.low_open], ")]"[not self.high_open]
         return f"a number in {left}{self.low:g}, {self.high:g}{right}"
 
 
-@dataclass(frozen=True)
-class Length:
-    """A list of n entries."""
+INTERVAL = "interval"  # two numbers [low, high] with low < high
+POSITIVE, NON_NEGATIVE, FRACTION = Range(low_open=True), Range(), Range(high=1.0)
 
-    n: int
-
-
-# An interval [low, high] of two numbers with low < high.
-INTERVAL = "interval"
-POSITIVE, NON_NEGATIVE = Range(0.0, low_open=True), Range(0.0)
-FRACTION = Range(0.0, 1.0)
-
-# What the values at some key paths accept: a Range (of each entry of a list too), a
-# Length, INTERVAL or a tuple of accepted strings; the key paths are patterns separated by
-# spaces, '*' standing for any part of a name and '[*]' for any list index. Checked in this
-# order (tests/test_config.py: every pattern names a key).
-RULES: list[tuple[Range | Length | str | tuple[str, ...], str]] = [
+# What the values at some key paths accept: a Range (of each entry of a list too), a length
+# n (a list of n entries), INTERVAL or a tuple of accepted strings. The key paths are
+# patterns separated by spaces, '*' standing for any part of a name and '[*]' for any list
+# index. Checked in this order (tests/test_config.py: every pattern names a key).
+RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (("scripted", "reactive"), "human.mode"),
     (("left", "right"), "human.pulls[*].hand"),
     (("velocity", "path"), "human.reactive.guide"),
@@ -718,19 +673,19 @@ RULES: list[tuple[Range | Length | str | tuple[str, ...], str]] = [
         "perturbation.pushes[*].start_s perturbation.hand_wrench_noise_N "
         "perturbation.noise_seed",
     ),
-    (Range(1.0), "advancement.psi_dot_upper"),
-    (Range(0.0, 1.0, high_open=True), "advancement.taper_from_progress"),
-    (Range(0.0, 1.0, high_open=True), "controller.stance_from_progress"),
-    (Range(0.0, 1.0), "standup.guard_off_ratio controller.stance_vertical_weight_scale"),
+    (Range(low=1.0), "advancement.psi_dot_upper"),
+    (Range(high=1.0, high_open=True), "advancement.taper_from_progress"),
+    (Range(high=1.0, high_open=True), "controller.stance_from_progress"),
+    (FRACTION, "standup.guard_off_ratio controller.stance_vertical_weight_scale"),
     (Range(1.0, 4.0), "controller.seat_hinge_from_state controller.lean_states"),
-    (Length(2), "human.reactive.path_xz_m[*]"),
+    (2, "human.reactive.path_xz_m[*]"),
     (
-        Length(3),
+        3,
         "initial.base_* visualization.*_xyz_m human.pulls[*].force_N "
         "human.reactive.target_velocity_mps standup.segment_psi standup.state*_com_delta_m "
         "controller.com_kp_* perturbation.pushes[*].force_N",
     ),
-    (Length(4), "controller.base_pitch_by_state_rad"),
+    (4, "controller.base_pitch_by_state_rad"),
     (INTERVAL, "human.reactive.ease_com_rise_m controller.*_cop_*_m"),
 ]
 
@@ -743,20 +698,15 @@ def _pattern(rule: str) -> re.Pattern:
 _COMPILED = [(_pattern(rule), accepted) for accepted, rules in RULES for rule in rules.split()]
 
 
-def _nodes(data, steps: list | None = None) -> Iterator[tuple[str, object]]:
-    """(key path, value) of every node of plain data, containers and leaves."""
-    steps = steps or []
-    if steps:
-        yield _format(steps), data
-    items = (
-        data.items()
-        if isinstance(data, dict)
-        else enumerate(data)
-        if isinstance(data, list)
-        else ()
-    )
+def _nodes(data, steps: tuple = (), leaves: bool = False) -> Iterator[tuple[str, object]]:
+    """(key path, value) of every node of plain data (leaves: of every leaf only; an
+    empty list is a leaf)."""
+    kind = dict if isinstance(data, dict) else list if isinstance(data, list) else None
+    items = list(data.items() if kind is dict else enumerate(data) if kind else ())
+    if steps and not (leaves and items):
+        yield _format(list(steps)), data
     for key, value in items:
-        yield from _nodes(value, steps + [key])
+        yield from _nodes(value, (*steps, key), leaves)
 
 
 def _check(key: str, value, accepted) -> None:
@@ -770,10 +720,10 @@ def _check(key: str, value, accepted) -> None:
     elif isinstance(accepted, tuple):
         if value not in accepted:
             raise ScenarioError(f"{key}: '{value}' unknown; accepted: {' | '.join(accepted)}")
-    elif isinstance(accepted, Length):
-        if len(value) != accepted.n:
+    elif isinstance(accepted, int):
+        if len(value) != accepted:
             raise ScenarioError(
-                f"{key}: {len(value)} values; accepted: a list of {accepted.n} numbers"
+                f"{key}: {len(value)} values; accepted: a list of {accepted} numbers"
             )
     elif accepted == INTERVAL:
         if len(value) != 2 or not value[0] < value[1]:
