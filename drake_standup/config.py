@@ -18,7 +18,7 @@ from pathlib import Path
 import yaml
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
-from pydrake.systems.analysis import SimulatorConfig
+from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
 from drake_standup.control.qp import SOLVERS
 from drake_standup.controller import ControllerConfig
@@ -646,6 +646,10 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (("tangent", "interaction"), "advancement.law"),
     (("hands", "time"), "standup.trigger"),
     (SOLVERS, "controller.qp_solver"),
+    (tuple(GetIntegrationSchemes()), "simulator.integration_scheme"),
+    (("point", "hydroelastic", "hydroelastic_with_fallback"), "plant.contact_model"),
+    (("", "tamsi", "sap", "similar", "lagged"), "plant.discrete_contact_approximation"),
+    (("triangle", "polygon"), "plant.contact_surface_representation"),
     (
         POSITIVE,
         "duration_s log_period_s controller_period_s simulator.max_step_size "
@@ -657,7 +661,8 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "controller.joint_limit_horizon_s controller.*friction_coefficient* "
         "controller.*_max_normal_force_N controller.torque_limit_Nm controller.help_* "
         "fall.max_com_horizontal_m perturbation.pushes[*].duration_s perturbation.*_scale "
-        "perturbation.hand_wrench_noise_period_s",
+        "perturbation.hand_wrench_noise_period_s plant.penetration_allowance "
+        "plant.stiction_tolerance simulator.accuracy",
     ),
     (
         NON_NEGATIVE,
@@ -671,7 +676,8 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "controller.*_damping_ratio controller.posture_limit_margin_rad controller.*_N "
         "controller.lean_max_* seat_hold.* fall.max_qp_failure_streak_s "
         "perturbation.pushes[*].start_s perturbation.hand_wrench_noise_N "
-        "perturbation.noise_seed",
+        "perturbation.noise_seed plant.sap_near_rigid_threshold simulator.target_realtime_rate "
+        "simulator.start_time fall.min_root_height_m",
     ),
     (Range(low=1.0), "advancement.psi_dot_upper"),
     (Range(high=1.0, high_open=True), "advancement.taper_from_progress"),
@@ -681,7 +687,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (2, "human.reactive.path_xz_m[*]"),
     (
         3,
-        "initial.base_* visualization.*_xyz_m human.pulls[*].force_N "
+        "initial.base_* visualization.*_xyz_m chair.xyz_m human.pulls[*].force_N "
         "human.reactive.target_velocity_mps standup.segment_psi standup.state*_com_delta_m "
         "controller.com_kp_* perturbation.pushes[*].force_N",
     ),
