@@ -28,8 +28,8 @@ def _run(command: list, cwd: Path, env: dict, timeout: float) -> str:
 
 @pytest.mark.slow
 def test_the_wheel_installs_and_runs_from_an_empty_folder(tmp_path):
-    """pip wheel of the repository, installed (with --system-site-packages, so the heavy
-    dependencies come from this environment instead of a download) into a new venv; from
+    """pip wheel of the repository, installed into a new venv (the heavy dependencies
+    come from this environment instead of a download); from
     an empty folder: run writes metrics.json and the figures, sweep writes its table,
     scenarios lists what the repository ships, and the package imported is the wheel's."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
@@ -42,10 +42,16 @@ def test_the_wheel_installs_and_runs_from_an_empty_folder(tmp_path):
     pip_wheel = [sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", wheels, source]
     _run(pip_wheel, tmp_path, env, 600)
     (wheel,) = wheels.glob("drake_standup-*.whl")
-    venv.create(tmp_path / "venv", system_site_packages=True, with_pip=True)
+    # The venv sees this environment's packages after its own (a .pth line: no download
+    # of Drake), but not this environment's editable install of the repository.
+    venv.create(tmp_path / "venv", with_pip=False)
     bin_dir = tmp_path / "venv" / "bin"
-    pip = [bin_dir / "python", "-m", "pip", "install", "-q", "--no-deps", "--force-reinstall"]
-    _run([*pip, wheel], tmp_path, env, 600)
+    purelib = "import sysconfig; print(sysconfig.get_paths()['purelib'])"
+    site_dir = Path(_run([bin_dir / "python", "-c", purelib], tmp_path, env, 60).strip())
+    outer = [p for p in sys.path if Path(p).name in ("site-packages", "dist-packages")]
+    (site_dir / "outer_environment.pth").write_text("\n".join(outer) + "\n")
+    pip = [sys.executable, "-m", "pip", "--python", bin_dir / "python", "install", "-q"]
+    _run([*pip, "--no-deps", wheel], tmp_path, env, 600)
     env["PATH"] = f"{bin_dir}{os.pathsep}{env['PATH']}"
     work = tmp_path / "work"
     work.mkdir()
