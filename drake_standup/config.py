@@ -457,14 +457,7 @@ def apply_overrides(scenario: Scenario, overrides: Iterable) -> Scenario:
     data = _plain(scenario)
     layer = {}
     for path, value in overrides:
-        steps = _parse_key_path(path)
-        if "*" in steps:
-            raise ScenarioError(f"key path '{path}': [*] names several keys; set them one by one")
-        parent = data
-        for depth, step in enumerate(steps[:-1]):
-            parent = _child(path, parent, step, steps[:depth])
-        _child(path, parent, steps[-1], steps[:-1], new_key_ok=True)
-        parent[steps[-1]] = value
+        steps = _set(data, path, value)
         layer[steps[0]] = data[steps[0]]
     if layer:
         scenario = _load(yaml.safe_dump(layer), layer, scenario)
@@ -477,7 +470,8 @@ def expand_key_path(scenario: Scenario, path: str) -> list[str]:
     if "[*]" not in path:
         return [path]
     pattern = _pattern(path)
-    return [key for key, _ in _nodes(_plain(scenario)) if pattern.fullmatch(key)]
+    keys = [_format(steps) for steps, _ in _nodes(_plain(scenario))]
+    return [key for key in keys if pattern.fullmatch(key)]
 
 
 def chair_file(name: str) -> Path:
@@ -496,8 +490,7 @@ def _load(text: str, raw: dict, defaults: Scenario) -> Scenario:
     try:
         return yaml_load_typed(schema=Scenario, data=text, defaults=defaults)
     except (RuntimeError, ValueError, TypeError, AssertionError) as err:
-        for key, value in _nodes(raw, leaves=True):
-            steps = _parse_key_path(key)
+        for steps, value in _nodes(raw, leaves=True):
             try:
                 yaml_load_typed(schema=Scenario, data=yaml.safe_dump(_nest(steps, value)))
             except (RuntimeError, ValueError, TypeError, AssertionError):
@@ -565,48 +558,38 @@ def _one_line(err: Exception) -> str:
     return " ".join(str(err).split())
 
 
-# --- Key paths: 'human.pulls[0].force_N[0]', 'human.pulls[*].force_N[2]' ----------------
+# --- Key paths: 'human.pulls[0].force_N[0]' ---------------------------------------------
 
-_SEGMENT = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[(?:\d+|\*)\])*)$")
+_KEY_PATH = re.compile(r"[A-Za-z_]\w*(\[\d+\])*(\.[A-Za-z_]\w*(\[\d+\])*)*")
 
 
-def _parse_key_path(path: str) -> list[str | int]:
-    """'a.b[0][*]' -> ['a', 'b', 0, '*']."""
-    steps: list[str | int] = []
-    for part in path.split("."):
-        match = _SEGMENT.match(part.strip())
-        if match is None:
+def _set(data: dict, path: str, value) -> list[str | int]:
+    """Sets the value at a key path of plain data; returns the path's steps. A mapping may
+    gain a key (Drake's loader then names one its schema lacks), a list no entry."""
+    if not _KEY_PATH.fullmatch(path):
+        raise ScenarioError(
+            f"key path '{path}': accepted: names joined by '.', each with an optional [index]"
+            ", e.g. human.pulls[0].force_N[0]"
+        )
+    steps = [int(s) if s.isdigit() else s for s in re.findall(r"[^.\[\]]+", path)]
+    node = data
+    for depth, step in enumerate(steps):
+        where = _format(steps[:depth]) or "scenario"
+        if not isinstance(node, list if isinstance(step, int) else dict):
+            kind = {list: "a list", dict: "a mapping"}.get(type(node), "a value")
+            raise ScenarioError(f"key path '{path}': {where} is {kind}")
+        if isinstance(step, int) and step >= len(node):
             raise ScenarioError(
-                f"key path '{path}': '{part}' is not a key; accepted: names joined by '.', "
-                "each with optional [index] or [*], e.g. human.pulls[0].force_N[0]"
+                f"key path '{path}': index {step} out of range; {where} has {len(node)} entries"
             )
-        steps.append(match.group(1))
-        steps += ["*" if i == "*" else int(i) for i in re.findall(r"\[(\d+|\*)\]", match.group(2))]
+        if depth < len(steps) - 1:
+            node = node[step] if isinstance(step, int) else node.setdefault(step, {})
+    node[steps[-1]] = value
     return steps
 
 
 def _format(steps: list[str | int]) -> str:
-    return "".join(f"[{s}]" if isinstance(s, int) or s == "*" else f".{s}" for s in steps)[1:]
-
-
-def _child(path: str, node, step: str | int, done: list, new_key_ok: bool = False):
-    """One step of a key path in plain data (new_key_ok: a mapping may gain the key)."""
-    where = _format(done) or "scenario"
-    if isinstance(step, str):
-        if not isinstance(node, dict):
-            raise ScenarioError(f"key path '{path}': {where} is a value, not a mapping")
-        if step not in node and not new_key_ok:
-            raise ScenarioError(
-                f"{_format(done + [step])}: unknown key; accepted: {', '.join(node)}"
-            )
-        return node.get(step)
-    if not isinstance(node, list):
-        raise ScenarioError(f"key path '{path}': {where} is not a list")
-    if step >= len(node):
-        raise ScenarioError(
-            f"key path '{path}': index {step} out of range; {where} has {len(node)} entries"
-        )
-    return node[step]
+    return "".join(f"[{s}]" if isinstance(s, int) else f".{s}" for s in steps)[1:]
 
 
 # --- Bounds and accepted values of every field ------------------------------------------
@@ -704,13 +687,13 @@ def _pattern(rule: str) -> re.Pattern:
 _COMPILED = [(_pattern(rule), accepted) for accepted, rules in RULES for rule in rules.split()]
 
 
-def _nodes(data, steps: tuple = (), leaves: bool = False) -> Iterator[tuple[str, object]]:
-    """(key path, value) of every node of plain data (leaves: of every leaf only; an
-    empty list is a leaf)."""
+def _nodes(data, steps: tuple = (), leaves: bool = False) -> Iterator[tuple[list, object]]:
+    """(key path steps, value) of every node of plain data (leaves: of every leaf only;
+    an empty list is a leaf)."""
     kind = dict if isinstance(data, dict) else list if isinstance(data, list) else None
     items = list(data.items() if kind is dict else enumerate(data) if kind else ())
     if steps and not (leaves and items):
-        yield _format(list(steps)), data
+        yield list(steps), data
     for key, value in items:
         yield from _nodes(value, (*steps, key), leaves)
 
@@ -742,7 +725,8 @@ def validate(scenario: Scenario) -> None:
     """Checks what the types alone cannot; raises ScenarioError (one line)."""
     from drake_standup.robot import robot_names
 
-    for key, value in _nodes(_plain(scenario)):
+    for steps, value in _nodes(_plain(scenario)):
+        key = _format(steps)
         _check(key, value, None)
         for pattern, accepted in _COMPILED:
             if pattern.fullmatch(key):
