@@ -121,9 +121,8 @@ def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> 
 
     try:
         overrides = [parse_set(text) for text in args.overrides]
-        if args.duration is not None:
-            overrides.append(("duration_s", args.duration))
-        scenario = load_scenario(args.scenario, overrides)
+        duration = [] if args.duration is None else [("duration_s", args.duration)]
+        scenario = load_scenario(args.scenario, overrides + duration)
     except ScenarioError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
