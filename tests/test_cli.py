@@ -4,6 +4,8 @@ one 'error:' line with exit code 2, whatever the input's source."""
 from __future__ import annotations
 
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -168,3 +170,17 @@ def test_no_command_lists_the_commands(capsys):
     code, stdout, _ = _cli(capsys, [])
     assert code == 2
     assert all(f"  {name} " in stdout for name in COMMANDS)
+
+
+def test_python_m_drake_standup_is_the_same_command(capsys):
+    """`python -m drake_standup scenarios` in a fresh process vs the command run here."""
+    done = subprocess.run(
+        [sys.executable, "-m", "drake_standup", "scenarios"],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == _cli(capsys, ["scenarios"])[1]
