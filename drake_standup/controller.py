@@ -192,8 +192,9 @@ class ControllerConfig:
     # thighs (measured). m.
     seat_cop_x_m: list[float] = field(default_factory=lambda: [-0.11, -0.06])
     seat_cop_y_m: list[float] = field(default_factory=lambda: [-0.05, 0.05])
-    # Joint torque saturation (SPEC 3). N m.
-    torque_limit_Nm: float = 60.0
+    # Joint torque saturation, N m. None: the actuators' effort limit in the plant
+    # (robot.effort_limit_Nm, SPEC 3); a number: a tighter limit of the controller's own.
+    torque_limit_Nm: float | None = None
     # ||xd_dot|| below which the helpful part of the pull fades out (smoothstep): the
     # standing robot compensates the whole pull (SPEC 7). m/s.
     help_fade_speed_mps: float = 0.02
@@ -279,7 +280,7 @@ class ControllerConfig:
     # alike, control/terms.py). With the nominal model a robot 15 % lighter rose 2 cm ahead
     # of its reference onto locked knees, and one 15 % heavier stalled in state 2 with the
     # hips on their stop (measured). 0: the nominal model throughout. s.
-    mass_estimation_time_constant_s: float = 0.3
+    mass_estimation_filter_s: float = 0.3
     # Bounds of the estimated mass scale (estimate / model).
     mass_scale_bounds: list[float] = field(default_factory=lambda: [0.7, 1.3])
     # QP solver: daqp (measured fastest, exact equalities), or Drake's osqp / clarabel.
@@ -415,6 +416,10 @@ class WholeBodyController(LeafSystem):
         self._config = config
         self._period_s = period_s
         self._B = plant.MakeActuationMatrix()
+        actuators = plant.GetJointActuatorIndices(robot.model_instance)
+        self._torque_limit_Nm = config.torque_limit_Nm or min(
+            plant.get_joint_actuator(i).effort_limit() for i in actuators
+        )
         self._nv, self._nu = nv, nu = self._B.shape
         self.contact_specs = _contact_specs(plant, robot, config)
         held_frames = [spec.frame for spec in self.contact_specs if spec.constrained]
@@ -537,7 +542,7 @@ class WholeBodyController(LeafSystem):
         state = context.get_discrete_state()
         mass_scale, began = state.get_value(self._mass_scale)
         began = began or standup_state > 1
-        tau_m = self._config.mass_estimation_time_constant_s
+        tau_m = self._config.mass_estimation_filter_s
         if not began and tau_m > 0.0 and self._support_port.HasValue(context):
             # Weighing while first seated: at rest m g = the pads' and the hands' vertical
             # forces. Frozen from the first stand-up on: a robot sat back by a hindering
@@ -637,7 +642,7 @@ class WholeBodyController(LeafSystem):
             qp = WholeBodyQp(
                 contact_map,
                 self._B,
-                torque_limit_Nm=config.torque_limit_Nm,
+                torque_limit_Nm=self._torque_limit_Nm,
                 torque_weight=config.torque_weight,
                 wrench_weight=config.wrench_weight,
                 acceleration_weight=config.acceleration_weight,

@@ -17,7 +17,7 @@ from pydrake.systems.primitives import (
 )
 
 from drake_standup.advancement import TrajectoryAdvancement
-from drake_standup.config import Scenario
+from drake_standup.config import Scenario, ScenarioError
 from drake_standup.contacts import ContactForceReporter
 from drake_standup.controller import WholeBodyController
 from drake_standup.human import HumanWrenchSource
@@ -124,10 +124,13 @@ def build_diagram(
 
     controller_system = None
     if controller == "whole_body":
-        controller_system = builder.AddNamedSystem(
-            "controller",
-            WholeBodyController(plant, robot, scenario.controller, scenario.controller_period_s),
-        )
+        try:
+            whole_body = WholeBodyController(
+                plant, robot, scenario.controller, scenario.controller_period_s
+            )
+        except ValueError as err:  # a setting only the model can check: a joint's name
+            raise ScenarioError(" ".join(str(err).split())) from None
+        controller_system = builder.AddNamedSystem("controller", whole_body)
         builder.Connect(robot_state, controller_system.GetInputPort("robot_state"))
         builder.Connect(
             reference.GetOutputPort("com_reference"),

@@ -31,8 +31,6 @@ from drake_standup.perturbations import apply_model_errors
 from drake_standup.progress import ProgressBar
 from drake_standup.scene import erect_com_height_m, set_seated_state
 
-GRAVITY_MPS2 = 9.81
-
 
 @dataclass
 class RunResult:
@@ -308,6 +306,10 @@ def _simulate_one(
         path = out_dir / "signals.npz"
         outputs.write_signals(path, result.signals)
         result.files["signals"] = path
+        # Every value simulated, as a scenario file (--scenario reruns it).
+        path = out_dir / "scenario.yaml"
+        path.write_text(yaml_dump_typed(scenario))
+        result.files["scenario"] = path
         # The figures draw the arrays signals.npz holds (the round trip is tested).
         entries = result.metrics.get("state_entry_times_s", [])
         path = out_dir / "figure_advancement.png"
@@ -461,7 +463,8 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
     # one (perturbation.mass_scale), whose weight the contacts carry.
     mass_kg = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
     simulated_mass_kg = plant.CalcTotalMass(plant.GetMyContextFromRoot(root_context), [instance])
-    metrics = outputs.seated_metrics(signals, weight_N=simulated_mass_kg * GRAVITY_MPS2)
+    g = -plant.gravity_field().gravity_vector()[2]
+    metrics = outputs.seated_metrics(signals, weight_N=simulated_mass_kg * g)
     metrics["robot_mass_kg"] = mass_kg
     metrics["simulated_mass_kg"] = simulated_mass_kg
     entry_times = built.state_machine.mode(
