@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """Simulate the iCub stand-up scenario and write recording, metrics and diagram.
 
-python run_diagram.py [--scenario PATH] [--out DIR] [--duration S]
+python run_diagram.py [--scenario PATH] [--out DIR] [--duration S] [--no-recording] [--live]
 """
 
 from __future__ import annotations
@@ -36,7 +36,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--no-recording", action="store_true", help="skip Meshcat and recording.html (faster)"
     )
+    parser.add_argument(
+        "--live",
+        action="store_true",
+        help="be the helper: paced at real time, pull the hands from the Meshcat page "
+        "(drake_standup/live.py); without --duration until Stop or Ctrl-C (at most 300 s)",
+    )
     args = parser.parse_args(argv)
+    if args.live and args.no_recording:
+        print("error: --no-recording: not with --live (the live page is Meshcat)", file=sys.stderr)
+        return 2
 
     from drake_standup.config import DEFAULT_SCENARIO, ScenarioError, load_scenario, validate
 
@@ -53,9 +62,14 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {err}", file=sys.stderr)
         return 2
 
-    from drake_standup.simulate import simulate
+    if args.live:
+        from drake_standup.live import run_live
 
-    result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
+        result = run_live(scenario, args.out, args.duration)
+    else:
+        from drake_standup.simulate import simulate
+
+        result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
     m = result.metrics
     for name, path in result.files.items():
         print(f"wrote {name}: {path}")

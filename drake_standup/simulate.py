@@ -78,6 +78,7 @@ def simulate(
     baseline: bool = False,
     controller: str = "whole_body",
     chunk_s: float = 0.05,
+    live=None,
 ) -> RunResult:
     """Simulates scenario; writes recording, metrics, figures and diagram into out_dir.
 
@@ -86,6 +87,7 @@ def simulate(
     standup_time_s_without_advancement. Where nothing could advance psi (no
     human, or advancement already off) the run is its own baseline.
     controller: 'whole_body', or 'seat_hold' (the plant-only benchmark).
+    live: a live.LiveSession (its Meshcat, its human, called after each chunk).
     """
     pending = None
     if baseline and scenario.advancement.enabled and _human_acts(scenario):
@@ -102,6 +104,7 @@ def simulate(
             label="simulating",
             baseline=pending,
             controller=controller,
+            live=live,
         )
     except BaseException:
         if pending is not None:
@@ -208,10 +211,14 @@ def _simulate_one(
     label: str,
     controller: str,
     baseline: _Baseline | None = None,
+    live=None,
 ) -> RunResult:
-    meshcat = make_meshcat() if record else None
+    if live is not None:
+        meshcat, make_human = live.meshcat, live.make_human
+    else:
+        meshcat, make_human = (make_meshcat() if record else None), None
     t_build = time.perf_counter()
-    built = build_diagram(scenario, meshcat, controller)
+    built = build_diagram(scenario, meshcat, controller, make_human)
     build_time_s = time.perf_counter() - t_build
 
     simulator = Simulator(built.diagram)
@@ -228,7 +235,7 @@ def _simulate_one(
     if meshcat is not None:
         vis = scenario.visualization
         meshcat.SetCameraPose(np.array(vis.camera_xyz_m), np.array(vis.target_xyz_m))
-        built.visualizer.StartRecording(set_transforms_while_recording=False)
+        built.visualizer.StartRecording(set_transforms_while_recording=live is not None)
 
     failure_reason = None
     bar = ProgressBar(scenario.duration_s, label) if progress else None
@@ -241,6 +248,8 @@ def _simulate_one(
         chunk_s = step_s * max(1, round(chunk_s / step_s))
     try:
         simulator.Initialize()
+        if live is not None:
+            live.started(simulator, built)
         chunk = 0
         while root_context.get_time() < scenario.duration_s - 1e-9:
             chunk += 1
@@ -252,6 +261,8 @@ def _simulate_one(
                 bar.update(root_context.get_time(), f"{rate:.2f}x real time")
             if status.reason() == status.ReturnReason.kReachedTerminationCondition:
                 failure_reason = fall.reason
+                break
+            if live is not None and live.after_chunk(simulator, built):
                 break
     except RuntimeError as err:
         failure_reason = "simulation error: " + " ".join(str(err).split())[:300]
