@@ -17,6 +17,9 @@ the eye already is, next to the robot.
 
 A publish-only system at the recording's rate: every property is set with the
 context's time, so it lands in the recording's frame of the visualizer's publish.
+A scaled shape's scale sits on a node of its own ('scaled') below the node that moves:
+the live viewer decomposes a transform into position, rotation and scale, so a
+transform sent to the same node would undo its scale.
 """
 
 from __future__ import annotations
@@ -104,7 +107,9 @@ class StandupVisuals(LeafSystem):
         m = self._meshcat
         length, radius = ARROW_HEAD_M
         for hand in ("left", "right"):
-            m.SetObject(f"{PREFIX}/pull/{hand}/shaft", Cylinder(ARROW_RADIUS_M, 1.0), PULL_RGBA)
+            m.SetObject(
+                f"{PREFIX}/pull/{hand}/shaft/scaled", Cylinder(ARROW_RADIUS_M, 1.0), PULL_RGBA
+            )
             # The cone's point at the arrow's tip (head), its base toward the hand.
             cone = f"{PREFIX}/pull/{hand}/head/cone"
             m.SetObject(cone, MeshcatCone(length, radius, radius), PULL_RGBA)
@@ -121,7 +126,7 @@ class StandupVisuals(LeafSystem):
             base = RigidTransform([x, bar_y, z])
             m.SetTransform(f"{PREFIX}/{name}", base)
             m.SetObject(
-                f"{PREFIX}/{name}/bar/box",
+                f"{PREFIX}/{name}/bar/scaled",
                 Box(BAR_WIDTH_M, BAR_WIDTH_M, 1.0),
                 Rgba(0.1, 0.45, 1.0, 1.0) if name == "psi_dot" else Rgba(0.55, 0.2, 0.9, 1.0),
             )
@@ -159,7 +164,7 @@ class StandupVisuals(LeafSystem):
             shaft = max(length - ARROW_HEAD_M[0], 1e-3)
             m.SetTransform(path, arrow_pose(p, f), t)
             m.SetTransform(f"{path}/shaft", RigidTransform([0.0, 0.0, shaft / 2]), t)
-            m.SetProperty(f"{path}/shaft", "scale", [1.0, 1.0, shaft], t)
+            m.SetProperty(f"{path}/shaft/scaled", "scale", [1.0, 1.0, shaft], t)
             m.SetTransform(f"{path}/head", RigidTransform([0.0, 0.0, length]), t)
         side = np.array([0.0, COM_SIDE_OFFSET_M, 0.0])
         m.SetTransform(f"{PREFIX}/com", RigidTransform(self._com.Eval(context) + side), t)
@@ -175,5 +180,5 @@ class StandupVisuals(LeafSystem):
         ):
             height = max(height, 1e-3)
             m.SetTransform(f"{PREFIX}/{name}/bar", RigidTransform([0.0, 0.0, height / 2]), t)
-            m.SetProperty(f"{PREFIX}/{name}/bar", "scale", [1.0, 1.0, height], t)
+            m.SetProperty(f"{PREFIX}/{name}/bar/scaled", "scale", [1.0, 1.0, height], t)
         return EventStatus.Succeeded()

@@ -49,7 +49,7 @@ def test_arrows_spheres_lamp_and_bars_show_the_pull_com_state_and_psi_dot():
     np.testing.assert_allclose(arrow.rotation().col(2), [0.8, 0.0, 0.6], atol=1e-12)
     length = 15.0 * PULL_M_PER_N
     assert _transform(m, f"{PREFIX}/pull/left/head").translation()[2] == length
-    assert _property(m, f"{PREFIX}/pull/left/shaft", "scale")[2] == length - ARROW_HEAD_M[0]
+    assert _property(m, f"{PREFIX}/pull/left/shaft/scaled", "scale")[2] == length - ARROW_HEAD_M[0]
     assert _property(m, f"{PREFIX}/pull/left", "visible") is True
     assert _property(m, f"{PREFIX}/pull/right", "visible") is False
 
@@ -64,7 +64,7 @@ def test_arrows_spheres_lamp_and_bars_show_the_pull_com_state_and_psi_dot():
     for k in range(1, 5):
         assert _property(m, f"{PREFIX}/state/{k}", "visible") is (k == state)
     psi_dot = live.output("advancement", "psi_dot")[0]
-    assert _property(m, f"{PREFIX}/psi_dot/bar", "scale")[2] == PSI_DOT_M * psi_dot
+    assert _property(m, f"{PREFIX}/psi_dot/bar/scaled", "scale")[2] == PSI_DOT_M * psi_dot
 
 
 def test_a_normal_runs_recording_holds_the_arrows(tmp_path):
