@@ -37,6 +37,7 @@ from pydrake.systems.framework import BasicVector, Context, DiscreteValues, Leaf
 from drake_standup.config import HumanConfig, Scenario
 from drake_standup.human import TASK_FRAMES
 from drake_standup.robot import Robot
+from drake_standup.simulate import RunResult, simulate
 
 # The page's controls, in the order they appear.
 HANDS = ("left", "right")
@@ -223,7 +224,9 @@ class LiveSession:
         self._initial_state = None
         self._reset_clicks = 0
 
-    def make_human(self, plant: MultibodyPlant, robot: Robot, config: HumanConfig):
+    def make_human(
+        self, plant: MultibodyPlant, robot: Robot, config: HumanConfig
+    ) -> LiveHumanSource:
         step = self._scenario.plant.time_step or self._scenario.controller_period_s
         self.human = LiveHumanSource(
             plant,
@@ -300,10 +303,8 @@ class LiveSession:
 
 def run_live(
     scenario: Scenario, out_dir: Path, duration_s: float | None = None, realtime_rate: float = 1.0
-):
+) -> RunResult:
     """The live run; prints the page's address, returns simulate()'s RunResult."""
-    from drake_standup.simulate import simulate
-
     scenario = copy.deepcopy(scenario)
     scenario.duration_s = DEFAULT_DURATION_S if duration_s is None else duration_s
     scenario.simulator.target_realtime_rate = realtime_rate

@@ -16,6 +16,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
@@ -30,6 +31,9 @@ from drake_standup.diagram import StandupDiagram, build_diagram
 from drake_standup.perturbations import apply_model_errors
 from drake_standup.progress import ProgressBar
 from drake_standup.scene import erect_com_height_m, set_seated_state
+
+if TYPE_CHECKING:
+    from drake_standup.live import LiveSession
 
 GRAVITY_MPS2 = 9.81
 
@@ -78,7 +82,7 @@ def simulate(
     baseline: bool = False,
     controller: str = "whole_body",
     chunk_s: float = 0.05,
-    live=None,
+    live: LiveSession | None = None,
 ) -> RunResult:
     """Simulates scenario; writes recording, metrics, figures and diagram into out_dir.
 
@@ -211,7 +215,7 @@ def _simulate_one(
     label: str,
     controller: str,
     baseline: _Baseline | None = None,
-    live=None,
+    live: LiveSession | None = None,
 ) -> RunResult:
     if live is not None:
         meshcat, make_human = live.meshcat, live.make_human
