@@ -7,7 +7,9 @@ Meshcat sliders (forward and up, N, within +-human.reactive.force_cap_N, the hel
 cap per hand), one switch pulls both hands together (the left hand's sliders drive
 both), and a standard gamepad, once the page has seen it, drives the pull from its
 sticks. "Stand up" starts the stand-up where standup.trigger waits for the hands,
-"Reset" puts the robot back on the chair, "Stop" (or Escape, or Ctrl-C) ends the run.
+"Reset" puts the robot back on the chair (also after a fall, which in a live run is
+reported on the console instead of ending it), "Stop" (or Escape, or Ctrl-C) ends the
+run.
 The rest of the diagram is the normal run's, and so are the outputs (metrics.json,
 signals.npz, figures, recording.html); there is no psi = t run beside it (nobody
 knows the pull in advance).
@@ -32,7 +34,13 @@ from pydrake.geometry import Meshcat, MeshcatParams
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import BasicVector, Context, DiscreteValues, LeafSystem
+from pydrake.systems.framework import (
+    BasicVector,
+    Context,
+    DiscreteValues,
+    EventStatus,
+    LeafSystem,
+)
 
 from drake_standup.config import HumanConfig, Scenario
 from drake_standup.human import TASK_FRAMES
@@ -219,6 +227,8 @@ class LiveSession:
         self._report = report
         self.human: LiveHumanSource | None = None
         self.stopped_by: str | None = None
+        self.fell: str | None = None  # what the fall monitor said, until a Reset
+        self._fall = None
         self.interrupted = False  # Ctrl-C (set by the signal handler)
         self.resets = 0
         self._initial_state = None
@@ -241,10 +251,24 @@ class LiveSession:
         self.meshcat.AddButton(STOP, "Escape")
         return self.human
 
-    def started(self, simulator: Simulator, built) -> None:
-        """After Initialize: the seated state that Reset returns to."""
+    def started(self, simulator: Simulator, built, fall=None) -> None:
+        """After Initialize: the seated state that Reset returns to; and the run's fall
+        monitor, which in a live run reports a fall (or the QP failing) once instead of
+        ending the run: Reset puts the robot back."""
         self._initial_state = simulator.get_context().Clone()
+        self._fall = fall
+        if fall is not None:
+            simulator.set_monitor(self._monitor)
         self._restart_clocks(simulator)
+
+    def _monitor(self, root_context: Context) -> EventStatus:
+        status = self._fall(root_context)
+        if status.severity() != EventStatus.Severity.kReachedTermination:
+            return status
+        if self.fell is None:
+            self.fell = status.message()
+            self._report(f"{self.fell}; Reset puts the robot back on the chair")
+        return EventStatus.DidNothing()
 
     def _restart_clocks(self, simulator: Simulator) -> None:
         """The pacing's origin and the rate report's, now (Drake's pacing restarts at
@@ -262,6 +286,9 @@ class LiveSession:
         built.diagram.ExecuteInitializationEvents(context)
         if self.human is not None:
             self.human.forget_clicks()
+        if self._fall is not None:
+            self._fall.reset()
+        self.fell = None
         simulator.ResetStatistics()
         self.resets += 1
 

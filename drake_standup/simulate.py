@@ -253,7 +253,7 @@ def _simulate_one(
     try:
         simulator.Initialize()
         if live is not None:
-            live.started(simulator, built)
+            live.started(simulator, built, fall)
         chunk = 0
         while root_context.get_time() < scenario.duration_s - 1e-9:
             chunk += 1
@@ -360,6 +360,11 @@ class _FallMonitor:
         self._max_streak_s = scenario.fall.max_qp_failure_streak_s
         self._failing_since: float | None = None
         self.reason: str | None = None
+
+    def reset(self) -> None:
+        """Forgets a fall and a run of QP failures (the live mode's Reset)."""
+        self._failing_since = None
+        self.reason = None
 
     def __call__(self, root_context) -> EventStatus:
         context = self._plant.GetMyContextFromRoot(root_context)

@@ -237,8 +237,8 @@ class _Pulling(LiveSession):
         super().__init__(scenario, make_live_meshcat(), report=lambda line: None)
         self._pull = pull
 
-    def started(self, simulator, built) -> None:
-        super().started(simulator, built)
+    def started(self, simulator, built, fall=None) -> None:
+        super().started(simulator, built, fall)
         _set_pull(self.meshcat, self._pull)
 
 
@@ -266,6 +266,42 @@ def test_a_helpful_slider_pull_advances_psi_and_a_backward_one_does_not():
     assert backward["state"].max() >= 3  # the robot rose against the pull
     assert backward["psi_dot"].min() == 1.0 and backward["psi_dot"].max() == 1.0
     np.testing.assert_array_equal(backward["psi"], backward["time_s"])
+
+
+class _Toppling(_Pulling):
+    """A helper who pulls 3 N back on each hand (below the hindering threshold: the
+    robot falls in state 2, README "Be the helper"), lets go and clicks Reset once
+    the console says it fell."""
+
+    def __init__(self, scenario):
+        super().__init__(scenario, (-3.0, 0.0))
+        self.lines = []
+        self._report = self.lines.append
+        self.reset_at = None
+
+    def after_chunk(self, simulator, built) -> bool:
+        if self.fell is not None and self.reset_at is None:
+            _set_pull(self.meshcat, (0.0, 0.0))
+            _click(self.meshcat, RESET)
+            self.reset_at = simulator.get_context().get_time()
+        return super().after_chunk(simulator, built)
+
+
+@pytest.mark.slow
+def test_a_live_run_goes_on_after_a_fall_and_reset_stands_the_robot_up_again():
+    """The fall is reported once and does not end the run; after Reset, nobody
+    pulling, the robot stands up on its own (trigger time) and stands at the end."""
+    scenario = _quick("time")
+    scenario.duration_s = 6.0
+    scenario.simulator.target_realtime_rate = 0.0
+    session = _Toppling(scenario)
+    result = simulate(scenario, None, progress=False, live=session)
+    assert [line for line in session.lines if line.startswith("fall:")] == session.lines[:1]
+    assert session.reset_at is not None and session.reset_at < 2.0
+    m = result.metrics
+    assert m["sim_time_s"] == pytest.approx(6.0)
+    assert m["state_entry_times_s"][1] > session.reset_at  # the stand-up after the Reset
+    assert m["success"], m["failure_reason"]
 
 
 @pytest.mark.slow
