@@ -349,3 +349,50 @@ def test_human_wrench_source_unchanged_by_the_live_mode():
     built = build_diagram(Scenario())
     assert not built.diagram.GetSubsystemByName("human").HasOutputPort("stand_up")
     assert isinstance(built.diagram.GetSubsystemByName("human"), HumanWrenchSource)
+
+
+class _FakeSimulator:
+    """What LiveSession's pacing reads of a Simulator: time, the target rate, and
+    ResetStatistics (Drake's pacing restarts there)."""
+
+    def __init__(self):
+        self.t = 0.0
+        self.restarts = []
+
+    def get_target_realtime_rate(self) -> float:
+        return 1.0
+
+    def get_context(self):
+        return self
+
+    def get_time(self) -> float:
+        return self.t
+
+    def ResetStatistics(self) -> None:
+        self.restarts.append(self.t)
+
+
+def test_pacing_reports_the_achieved_rate_once_a_second_and_never_catches_up(monkeypatch):
+    """A machine at half real time: one line a second with the rate over that second
+    (0.50x), and the pacing restarted whenever the simulation lags the wall clock by
+    more than MAX_LAG_S; at real time, nothing is said."""
+    from drake_standup import live
+
+    wall = [100.0]
+    monkeypatch.setattr(live.time, "perf_counter", lambda: wall[0])
+    lines = []
+    session = LiveSession(Scenario(), make_live_meshcat(), report=lines.append)
+    sim = _FakeSimulator()
+    session._restart_clocks(sim)
+    for _ in range(32):  # 2 s of wall time, 1 s simulated (binary fractions: exact)
+        wall[0] += 1 / 16
+        sim.t += 1 / 32
+        session._pace(sim)
+    assert lines == ["behind real time: 0.50x at t = 0.5 s", "behind real time: 0.50x at t = 1.0 s"]
+    assert len(sim.restarts) == 8  # every 0.25 s of wall time: 0.125 s behind
+    lines.clear()
+    for _ in range(32):  # real time
+        wall[0] += 1 / 16
+        sim.t += 1 / 16
+        session._pace(sim)
+    assert lines == [] and len(sim.restarts) == 8
