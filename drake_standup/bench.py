@@ -1,6 +1,6 @@
 """Benchmark: how fast the stand-up simulates, and where the time goes (issue 5).
 
-    python -m drake_standup.bench [--scenario PATH] [--duration S] [--plant-duration S]
+    drake-standup bench [--scenario PATH|NAME] [--duration S] [--plant-duration S]
                                   [--repeat N] [--plant-steps N] [--out FILE]
                                   [--profile [PATH]]
 
@@ -10,9 +10,9 @@ In one process, --repeat times each:
   (b) closed_loop_recording: the scenario under the whole-body controller with the
       Meshcat recording on, --duration simulated seconds (default: the scenario's);
   (c) closed_loop: the same without the recording;
-  (d) run_diagram: `python run_diagram.py` as a user runs it, once, in a fresh
-      process: imports, both simulations (the psi = t one beside the main one),
-      the recording and every output; --no-run-diagram skips it.
+  (d) run_diagram: `drake-standup run` (what `python run_diagram.py` runs) as a user
+      runs it, once, in a fresh process: imports, both simulations (the psi = t one
+      beside the main one), the recording and every output; --no-run-diagram skips it.
 Then the controller's tick split (WholeBodyController.timing_s()) and its share of
 the closed loop's wall time, the plant step timed one step at a time, the model
 build with a cold and a warm mesh cache, peak memory and the machine. One JSON
@@ -51,13 +51,13 @@ import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
+from drake_standup.cli import OneLineErrorParser
 from drake_standup.config import DEFAULT_SCENARIO, Scenario, ScenarioError, load_scenario
 from drake_standup.controller import WholeBodyController
 from drake_standup.diagram import add_seat_hold, build_diagram
 from drake_standup.scene import add_scene, set_seated_state
 from drake_standup.simulate import RunResult, simulate
 
-REPO_ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_PROFILE = Path("out") / "bench_profile.prof"
 PROFILE_TOP = 40  # functions listed in the profile's text summary
 
@@ -220,13 +220,13 @@ def _tick_share(results: list[RunResult], scenario: Scenario) -> dict:
     }
 
 
-def _run_diagram(scenario_path: Path) -> dict:
-    """`python run_diagram.py --scenario PATH --out TMP` in a fresh process: the
+def _run_diagram(scenario_path: str) -> dict:
+    """`drake-standup run --scenario PATH --out TMP` in a fresh process: the
     wall time a user waits for the whole job, and its summary line."""
     with tempfile.TemporaryDirectory(prefix="bench_run_diagram_") as tmp:
         t0 = time.perf_counter()
         done = subprocess.run(
-            [sys.executable, str(REPO_ROOT / "run_diagram.py"), "--scenario", str(scenario_path)]
+            [sys.executable, "-m", "drake_standup", "run", "--scenario", str(scenario_path)]
             + ["--out", tmp],
             capture_output=True,
             text=True,
@@ -325,7 +325,11 @@ def _git() -> dict:
     def git(*args: str) -> str:
         try:
             done = subprocess.run(
-                ["git", *args], cwd=REPO_ROOT, capture_output=True, text=True, check=False
+                ["git", *args],
+                cwd=Path(__file__).parent,
+                capture_output=True,
+                text=True,
+                check=False,
             )
         except OSError:
             return ""
@@ -354,11 +358,18 @@ def _positive_float(text: str) -> float:
     return value
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+def _parser(prog: str) -> argparse.ArgumentParser:
+    parser = OneLineErrorParser(
+        prog=prog,
+        description=__doc__,
+        epilog="example: drake-standup bench --scenario unassisted --repeat 1 --no-run-diagram",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--scenario", type=Path, default=DEFAULT_SCENARIO)
+    parser.add_argument(
+        "--scenario",
+        default=str(DEFAULT_SCENARIO),
+        help="a scenario YAML file, or a shipped scenario's name (default: assisted)",
+    )
     parser.add_argument(
         "--duration",
         type=_positive_float,
@@ -393,8 +404,8 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+def main(argv: list[str] | None = None, prog: str = "python -m drake_standup.bench") -> int:
+    args = _parser(prog).parse_args(argv)
     t_bench = time.perf_counter()
     git_start, load_start = _git(), list(os.getloadavg())
     try:

@@ -1,10 +1,26 @@
-"""What every command line of the project shares (no heavy imports here:
-run_diagram.py parses its arguments before it loads Drake)."""
+"""The command line: `drake-standup COMMAND` (also `python -m drake_standup COMMAND`).
+
+Commands: run (one scenario: recording, metrics, figures), sweep, bench, convergence and
+scenarios (what the package ships). Each command's module does the work; this one parses
+arguments and turns a bad input into one 'error:' line and exit code 2. No heavy imports
+here: a command parses its arguments before it loads Drake.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
+from pathlib import Path
+
+# Command -> (module with main(argv, prog), one line of help).
+COMMANDS = {
+    "run": ("drake_standup.cli", "simulate one scenario: recording, metrics, figures"),
+    "sweep": ("drake_standup.sweep", "many runs on Dask: a grid, random draws, perturbations"),
+    "bench": ("drake_standup.bench", "how fast the stand-up simulates, and where time goes"),
+    "convergence": ("drake_standup.convergence", "the plant-step convergence study"),
+    "scenarios": ("drake_standup.cli", "list the shipped scenarios and sweeps"),
+}
 
 
 class OneLineErrorParser(argparse.ArgumentParser):
@@ -13,3 +29,162 @@ class OneLineErrorParser(argparse.ArgumentParser):
     def error(self, message: str) -> None:
         print(f"error: {message}; see --help", file=sys.stderr)
         sys.exit(2)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """drake-standup COMMAND [ARGS]: hands ARGS to the command's own parser."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if not argv or argv[0] in ("-h", "--help"):
+        width = max(map(len, COMMANDS))
+        lines = [f"  {name:<{width}}  {text}" for name, (_, text) in COMMANDS.items()]
+        print("usage: drake-standup COMMAND [--help] [ARGS]\n\ncommands:", *lines, sep="\n")
+        print("\nexample: drake-standup run --scenario unassisted --duration 4 --no-recording")
+        return 0 if argv else 2
+    name, rest = argv[0], argv[1:]
+    if name not in COMMANDS:
+        print(
+            f"error: '{name}': unknown command; accepted: {' | '.join(COMMANDS)}", file=sys.stderr
+        )
+        return 2
+    prog = f"drake-standup {name}"
+    if name == "run":
+        return run_main(rest, prog)
+    if name == "scenarios":
+        return scenarios_main(rest, prog)
+    return importlib.import_module(COMMANDS[name][0]).main(rest, prog=prog)
+
+
+# --- run ---------------------------------------------------------------------------------
+
+
+def run_parser(prog: str) -> OneLineErrorParser:
+    """The run command's arguments (run_diagram.py's too)."""
+    parser = OneLineErrorParser(
+        prog=prog,
+        description="Simulate the iCub stand-up scenario and write recording, metrics, "
+        "figures and diagram.",
+        epilog="example:\n  drake-standup run --scenario unassisted --set "
+        "advancement.psi_dot_upper=2.0 --duration 4 --no-recording --out out/try",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--scenario",
+        default=None,
+        help="a scenario YAML file, or a shipped scenario's name, e.g. unassisted "
+        "(default: assisted; `drake-standup scenarios` lists them)",
+    )
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY.PATH=VALUE",
+        help="override one scenario value (YAML), e.g. advancement.psi_dot_upper=2.0 or "
+        "human.pulls[0].force_N=[20, 0, 20]; repeatable",
+    )
+    parser.add_argument(
+        "--out", type=Path, default=Path("out"), help="output directory (default: out/)"
+    )
+    parser.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        help="simulated seconds (overrides the scenario's duration_s)",
+    )
+    parser.add_argument(
+        "--no-recording", action="store_true", help="skip Meshcat and recording.html (faster)"
+    )
+    parser.add_argument(
+        "--live",
+        action="store_true",
+        help="be the helper: paced at real time, pull the hands from the Meshcat page "
+        "(drake_standup/live.py); without --duration until Stop or Ctrl-C (at most 300 s)",
+    )
+    return parser
+
+
+def parse_set(text: str) -> tuple[str, object]:
+    """--set's 'key.path=value' (the value in YAML: 2.0, time, [1, 0, 2]) -> (path, value)."""
+    import yaml
+
+    from drake_standup.config import ScenarioError
+
+    path, equals, value = text.partition("=")
+    try:
+        if equals and path.strip():
+            return path.strip(), yaml.safe_load(value)
+    except yaml.YAMLError:
+        pass
+    raise ScenarioError(
+        f"--set {text}: accepted: key.path=VALUE (YAML), e.g. advancement.eps=1.0e-4"
+    )
+
+
+def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> int:
+    args = run_parser(prog).parse_args(argv)
+    if args.live and args.no_recording:
+        print("error: --no-recording: not with --live (the live page is Meshcat)", file=sys.stderr)
+        return 2
+
+    from drake_standup.config import ScenarioError, load_scenario
+
+    try:
+        overrides = [parse_set(text) for text in args.overrides]
+        duration = [] if args.duration is None else [("duration_s", args.duration)]
+        scenario = load_scenario(args.scenario, overrides + duration)
+    except ScenarioError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+
+    from drake_standup.simulate import simulate
+
+    try:
+        if args.live:
+            from drake_standup.live import run_live
+
+            result = run_live(scenario, args.out, args.duration)
+        else:
+            result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
+    except ScenarioError as err:  # what only the built model can check (e.g. a body's name)
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    m = result.metrics
+    for name, path in result.files.items():
+        print(f"wrote {name}: {path}")
+    for path, value in overrides:
+        print(f"set {path} = {value}")
+    if m.get("standup_time_s") is not None:
+        outcome = f"stood up in {m['standup_time_s']:.2f} s"
+        if m.get("standup_time_s_without_advancement") is not None:
+            outcome += f" ({m['standup_time_s_without_advancement']:.2f} s without advancement)"
+        elif "standup_time_s_without_advancement" in m:
+            outcome += " (did not stand up without advancement)"
+    else:
+        outcome = "did not stand up"
+    status = "OK" if m["success"] else f"FAILED ({m['failure_reason']})"
+    print(
+        f"{status}: {outcome}; psi_final {m.get('psi_final', float('nan')):.2f}; "
+        f"simulated {m['sim_time_s']:.2f} s in {m['wall_time_s']:.1f} s wall "
+        f"({m['realtime_factor']:.2f}x real time)"
+    )
+    return 0
+
+
+# --- scenarios ---------------------------------------------------------------------------
+
+
+def scenarios_main(argv: list[str] | None = None, prog: str = "drake-standup scenarios") -> int:
+    OneLineErrorParser(
+        prog=prog,
+        description="List the shipped scenarios and sweeps, each with its one-line "
+        "description; run one by its name.",
+        epilog="example:\n  drake-standup scenarios\n  drake-standup run --scenario seated",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    ).parse_args(argv)
+    from drake_standup.resources import data_root, description, shipped
+
+    for folder, command in (("scenarios", "run --scenario"), ("sweeps", "sweep")):
+        print(f"{folder} ({data_root() / folder}; drake-standup {command} NAME):")
+        for name, path in shipped(folder).items():
+            print(f"  {name:<12} {description(path)}")
+    return 0

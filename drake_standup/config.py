@@ -3,24 +3,29 @@
 A scenario is a YAML file loaded into the typed dataclasses below with Drake's
 yaml_load_typed, so an unknown key or a wrong type is an error rather than a
 silently ignored typo. Defaults live here and nowhere else; the YAML files in
-scenarios/ override what they name.
+scenarios/ override what they name, and overrides (a sweep's, or `--set key.path=value`
+on the command line) are one more YAML layer through the same loader. What the types
+alone cannot say (bounds, accepted values, lengths) is checked in one table, RULES.
 """
 
 import math
 import re
 import typing
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
-from pydrake.common.yaml import yaml_load_typed
+from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
-from pydrake.systems.analysis import SimulatorConfig
+from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
+from drake_standup.control.qp import SOLVERS
 from drake_standup.controller import ControllerConfig
+from drake_standup.resources import data_root, shipped
+from drake_standup.robot import EFFORT_LIMIT_NM
 
-REPO_ROOT = Path(__file__).resolve().parent.parent
-SCENARIO_DIR = REPO_ROOT / "scenarios"
+SCENARIO_DIR = data_root() / "scenarios"
 DEFAULT_SCENARIO = SCENARIO_DIR / "assisted.yaml"
 
 
@@ -57,8 +62,8 @@ class RobotConfig:
     model: str = "iCubGazeboV2_5"
     # Replace massless sensor/skin links by frames (SPEC 5: 3-10x faster terms).
     reduced: bool = True
-    # Torque saturation of the authors' controller (SPEC 3), N m.
-    effort_limit_Nm: float = 60.0
+    # Every actuator's effort limit, which the controller reads from the plant. N m.
+    effort_limit_Nm: float = EFFORT_LIMIT_NM
     # Triangles per visual mesh after decimation. Meshcat's HTML is 2.2 MB of
     # viewer, ~0.15 MB per simulated second of animation, plus the meshes: at
     # 1000 faces they take ~1.3 MB and a 15 s recording stays under 8 MB.
@@ -78,7 +83,8 @@ class InitialPose:
 
 @dataclass
 class ChairConfig:
-    # models/chair.sdf: seat top at 0.2195 m, where the seated pads rest.
+    # The shipped models/chair.sdf (seat top at 0.2195 m, where the seated pads rest), or
+    # an SDF file of your own: absolute, or relative to the current directory.
     file: str = "models/chair.sdf"
     # Where the chair's model frame (floor, below the seat's front edge) stands.
     # The front edge sits behind the knees (x ~ 0.22 m seated). m.
@@ -216,10 +222,21 @@ class StandupConfig:
     hand_force_threshold_N: float = 10.0
     # Both hands together pulled backwards by more than this (filtered, with the
     # guards' hysteresis and dwell): the stand-up waits. Seated it does not start;
-    # in state 2 (the thighs still on the chair) it sits back into state 1; in
-    # state 3 it holds. psi = t meanwhile (the pull does not help). Issue 13:
-    # 10 N backwards per hand toppled the robot over the chair. N.
+    # in state 2, or in state 3 while the thighs still carry most of their load
+    # (reseat_above_thigh_load), it sits back into state 1; later in state 3 it
+    # holds. psi = t meanwhile (the pull does not help). Issue 13: 10 N backwards
+    # per hand toppled the robot over the chair. N.
     hindering_force_threshold_N: float = 8.0
+    # Once a hindering pull has stopped, the stand-up waits this long before it
+    # (re)starts from state 1 or goes on from state 3: the pull is over, not
+    # paused, and the arms it swung back return to their posture first. s.
+    resume_after_s: float = 0.5
+    # In state 3 a hindering pull sits the robot back while the thighs' release
+    # has left them more than this fraction of their load (the plan's smoothstep);
+    # later state 3 holds. Sat back with the thighs at 0.4 of their load, the
+    # robot's feet were left unloaded on the chair and its next attempt fell back;
+    # holding there, it stood (measured, 15 N per hand).
+    reseat_above_thigh_load: float = 0.5
     # Min-jerk segment lengths of states 2, 3, 4 in units of psi (= s when
     # psi = t); the advancement version's [1.5, 0.5, 1.8] (SPEC 3).
     segment_psi: list[float] = field(default_factory=lambda: [1.5, 0.5, 1.8])
@@ -412,261 +429,346 @@ class Scenario:
     log_period_s: float = 0.01
 
 
-def load_scenario(path: str | Path | None = None) -> Scenario:
-    """Loads and validates a scenario file; raises ScenarioError (one line)."""
-    path = Path(path) if path is not None else DEFAULT_SCENARIO
-    if not path.is_file():
-        shipped = sorted(str(p.relative_to(REPO_ROOT)) for p in SCENARIO_DIR.glob("*.yaml"))
+def load_scenario(path: str | Path | None = None, overrides: Iterable = ()) -> Scenario:
+    """Loads a scenario file (a path, or the name of a shipped scenario), applies overrides
+    [(key path, value)] and validates; raises ScenarioError (one line)."""
+    from drake_standup.resources import find
+
+    found = find("scenarios", path) if path is not None else DEFAULT_SCENARIO
+    if found is None:
         raise ScenarioError(
-            f"scenario: file '{path}' not found; accepted: a YAML file, e.g. {', '.join(shipped)}"
+            f"scenario: file '{path}' not found; accepted: a YAML file or a shipped "
+            f"scenario: {', '.join(shipped('scenarios'))}"
         )
-    return parse_scenario(path.read_text(), str(path))
+    return parse_scenario(found.read_text(), str(found), overrides)
 
 
-def parse_scenario(text: str, where: str = "scenario") -> Scenario:
-    """A scenario from YAML text (where: its name in error messages)."""
+def parse_scenario(text: str, where: str = "scenario", overrides: Iterable = ()) -> Scenario:
+    """A scenario from YAML text (where: its name in error messages), with overrides."""
     try:
         raw = yaml.safe_load(text)
     except yaml.YAMLError as err:
         raise ScenarioError(f"scenario {where}: not valid YAML ({_one_line(err)})") from None
-    if raw is None:
-        raw = {}
-    _check_schema("", raw, Scenario)
-    try:
-        scenario = yaml_load_typed(schema=Scenario, data=text) if raw else Scenario()
-    except (RuntimeError, ValueError, TypeError) as err:
-        raise ScenarioError(f"scenario {where}: {_one_line(err)}") from None
+    if not isinstance(raw, dict | None):
+        raise ScenarioError(
+            f"scenario {where}: {raw!r}; accepted: a mapping of {', '.join(_fields(Scenario))}"
+        )
+    scenario = _load(text, raw or {}, Scenario()) if raw else Scenario()
+    return apply_overrides(scenario, overrides)
+
+
+def apply_overrides(scenario: Scenario, overrides: Iterable) -> Scenario:
+    """A copy of scenario with each (key path, value) set, validated.
+
+    The overrides are one more YAML layer: the top-level keys they touch, written out
+    whole with the values set, loaded by yaml_load_typed with scenario as the defaults:
+    the typed parser, and the errors, of a scenario file. A key path is names joined by
+    '.' with [index] for list entries, e.g. human.pulls[0].force_N[2].
+    """
+    data = _plain(scenario)
+    layer = {}
+    for path, value in overrides:
+        steps = _set(data, path, value)
+        layer[steps[0]] = data[steps[0]]
+    if layer:
+        scenario = _load(yaml.safe_dump(layer), layer, scenario)
     validate(scenario)
     return scenario
 
 
-# --- Key paths: 'human.pulls[0].force_N[0]', 'advancement.psi_dot_upper' -------
-
-_SEGMENT = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[(?:\d+|\*)\])*)$")
-
-
-def _parse_key_path(path: str) -> list[str | int]:
-    """'a.b[0][*]' -> ['a', 'b', 0, '*']."""
-    steps: list[str | int] = []
-    for part in path.split("."):
-        match = _SEGMENT.match(part.strip())
-        if match is None:
-            raise ScenarioError(
-                f"key path '{path}': '{part}' is not a key; accepted: names joined by '.', "
-                "each with optional [index] or [*], e.g. human.pulls[0].force_N[0]"
-            )
-        steps.append(match.group(1))
-        steps += ["*" if i == "*" else int(i) for i in re.findall(r"\[(\d+|\*)\]", match.group(2))]
-    return steps
-
-
-def _format_key_path(steps: list[str | int]) -> str:
-    out = ""
-    for step in steps:
-        out += f"[{step}]" if isinstance(step, int) or step == "*" else f".{step}"
-    return out.lstrip(".")
-
-
-def _child(path: str, obj, schema, step: str | int, done: list, new_key_ok: bool = False):
-    """One concrete step of a key path: (the value there, its declared type).
-
-    new_key_ok: a key not yet in a mapping (e.g. a joint of joints_rad) is
-    allowed; its value is then None.
-    """
-    where = _format_key_path(done) or "scenario"
-    if isinstance(step, str):
-        fields = _fields(schema)
-        if fields is not None:
-            if step not in fields:
-                raise ScenarioError(
-                    f"key path '{path}': {where} has no key '{step}'; accepted: {', '.join(fields)}"
-                )
-            return getattr(obj, step), fields[step]
-        if isinstance(obj, dict):
-            if step not in obj and not new_key_ok:
-                raise ScenarioError(
-                    f"key path '{path}': {where} has no key '{step}'; accepted: {', '.join(obj)}"
-                )
-            return obj.get(step), typing.get_args(schema)[1]
-        raise ScenarioError(f"key path '{path}': {where} is a value, not a mapping")
-    if not isinstance(obj, list):
-        raise ScenarioError(f"key path '{path}': {where} is not a list")
-    if step >= len(obj):
-        raise ScenarioError(
-            f"key path '{path}': index {step} out of range; {where} has {len(obj)} entries"
-        )
-    return obj[step], typing.get_args(schema)[0]
-
-
 def expand_key_path(scenario: Scenario, path: str) -> list[str]:
-    """The concrete key paths a path names in scenario ([*]: every element)."""
-    steps = _parse_key_path(path)
-    found: list[list[str | int]] = []
+    """The concrete key paths a path names in scenario ([*]: every entry of a list)."""
+    if "[*]" not in path:
+        return [path]
+    pattern = _pattern(path)
+    keys = [_format(steps) for steps, _ in _nodes(_plain(scenario))]
+    return [key for key in keys if pattern.fullmatch(key)]
 
-    def walk(obj, schema, done: list, rest: list) -> None:
-        if not rest:
-            found.append(done)
-            return
-        step, rest = rest[0], rest[1:]
-        if step == "*":
-            if not isinstance(obj, list):
-                where = _format_key_path(done) or "scenario"
-                raise ScenarioError(f"key path '{path}': {where} is not a list")
-            concrete = list(range(len(obj)))
+
+def chair_file(name: str) -> Path:
+    """chair.file as a path: the shipped models/chair.sdf, or the user's own file."""
+    own = Path(name)
+    return own if own.is_absolute() or own.is_file() else data_root() / name
+
+
+# --- Drake's loader, and errors that name the key path -----------------------------------
+
+
+def _load(text: str, raw: dict, defaults: Scenario) -> Scenario:
+    """yaml_load_typed(text) over defaults. Drake's own errors do not say where (nor do
+    its ValueErrors name a key), so on failure each leaf of raw is loaded alone to find
+    the key path to name."""
+    try:
+        return yaml_load_typed(schema=Scenario, data=text, defaults=defaults)
+    except (RuntimeError, ValueError, TypeError, AssertionError) as err:
+        for steps, value in _nodes(raw, leaves=True):
+            try:
+                yaml_load_typed(schema=Scenario, data=yaml.safe_dump(_nest(steps, value)))
+            except (RuntimeError, ValueError, TypeError, AssertionError):
+                raise ScenarioError(_type_error(steps, raw)) from None
+        raise ScenarioError(f"scenario: {_one_line(err)}") from None
+
+
+def _type_error(steps: list, raw: dict) -> str:
+    """The message for the leaf at steps that Drake's loader rejected: an unknown key, or
+    a value of the wrong type (named at the first step the schema has no room for)."""
+    schema = Scenario
+    for depth, step in enumerate(steps):
+        fields = _fields(schema)
+        if isinstance(step, str) and fields is not None and step not in fields:
+            return f"{_format(steps[: depth + 1])}: unknown key; accepted: {', '.join(fields)}"
+        origin, args = typing.get_origin(schema), typing.get_args(schema)
+        if isinstance(step, int) and origin is list:
+            schema = args[0]
+        elif isinstance(step, str) and (fields is not None or origin is dict):
+            schema = fields[step] if fields is not None else args[1]
         else:
-            concrete = [step]
-        for c in concrete:
-            walk(*_child(path, obj, schema, c, done), done + [c], rest)
-
-    walk(scenario, Scenario, [], steps)
-    return [_format_key_path(s) for s in found]
-
-
-def set_key_path(scenario: Scenario, path: str, value) -> None:
-    """Sets one concrete key path (no [*]) to value, type-checked as in a file.
-
-    A mapping for a dataclass-valued key builds that dataclass (its defaults
-    for what the mapping leaves out); a list of mappings, a list of them.
-    """
-    steps = _parse_key_path(path)
-    if "*" in steps:
-        raise ScenarioError(f"key path '{path}': [*] names several keys; set them one by one")
-    parent, schema = scenario, Scenario
-    for depth, step in enumerate(steps[:-1]):
-        parent, schema = _child(path, parent, schema, step, steps[:depth])
-    step = steps[-1]
-    _, schema = _child(path, parent, schema, step, steps[:-1], new_key_ok=True)
-    _check_schema(_format_key_path(steps), value, schema)
-    new = _typed(schema, value)
-    if isinstance(step, int) or isinstance(parent, dict):
-        parent[step] = new
+            break
     else:
-        setattr(parent, step, new)
+        depth = len(steps)
+    where = steps[:depth]
+    return f"{_format(where)}: {_node(raw, where)!r}; accepted: {_type_name(schema)}"
 
 
-def _typed(schema, value):
-    """value (plain YAML data, already schema-checked) as an object of schema."""
-    fields = _fields(schema)
-    if fields is not None and isinstance(value, dict):
-        obj = schema()
-        for key, item in value.items():
-            setattr(obj, key, _typed(fields[key], item))
-        return obj
-    if typing.get_origin(schema) is list:
-        return [_typed(typing.get_args(schema)[0], v) for v in value]
-    if schema is float and isinstance(value, int):
-        return float(value)
+def _type_name(schema) -> str:
+    if (fields := _fields(schema)) is not None:
+        return f"a mapping of {', '.join(fields)}"
+    names = {float: "a number", int: "an integer", bool: "true or false", str: "a string"}
+    origin = typing.get_origin(schema)
+    return names.get(schema) or {list: "a list", dict: "a mapping"}.get(origin, str(schema))
+
+
+def _fields(schema) -> dict[str, typing.Any] | None:
+    """Field name -> type of one of our dataclasses or of one of Drake's config structs."""
+    if hasattr(schema, "__dataclass_fields__"):
+        return typing.get_type_hints(schema)
+    if hasattr(schema, "__fields__"):
+        return {f.name: f.type for f in schema.__fields__}
+    return None
+
+
+def _plain(scenario: Scenario) -> dict:
+    """scenario as plain YAML data (dicts, lists, numbers, strings)."""
+    return yaml.safe_load(yaml_dump_typed(scenario))
+
+
+def _nest(steps: list, value):
+    """The smallest document that holds value at steps (a list entry as a 1-entry list)."""
+    for step in reversed(steps):
+        value = [value] if isinstance(step, int) else {step: value}
     return value
+
+
+def _node(data, steps: list):
+    for step in steps:
+        data = data[step]
+    return data
 
 
 def _one_line(err: Exception) -> str:
     return " ".join(str(err).split())
 
 
-def _fields(schema) -> dict[str, typing.Any] | None:
-    """Field name -> type of one of our dataclasses or one of Drake's structs."""
-    if hasattr(schema, "__dataclass_fields__"):
-        hints = typing.get_type_hints(schema)
-        return {name: hints[name] for name in schema.__dataclass_fields__}
-    if hasattr(schema, "__fields__"):  # Drake's C++ config structs
-        return {f.name: f.type for f in schema.__fields__}
-    return None
+# --- Key paths: 'human.pulls[0].force_N[0]' ---------------------------------------------
+
+_KEY_PATH = re.compile(r"[A-Za-z_]\w*(\[\d+\])*(\.[A-Za-z_]\w*(\[\d+\])*)*")
 
 
-def _type_name(kind) -> str:
-    return {float: "a number", int: "an integer", bool: "true or false", str: "a string"}.get(
-        kind, getattr(kind, "__name__", str(kind))
-    )
+def _set(data: dict, path: str, value) -> list[str | int]:
+    """Sets the value at a key path of plain data; returns the path's steps. A mapping may
+    gain a key (Drake's loader then names one its schema lacks), a list no entry."""
+    if not _KEY_PATH.fullmatch(path):
+        raise ScenarioError(
+            f"key path '{path}': accepted: names joined by '.', each with an optional [index]"
+            ", e.g. human.pulls[0].force_N[0]"
+        )
+    steps = [int(s) if s.isdigit() else s for s in re.findall(r"[^.\[\]]+", path)]
+    node = data
+    for depth, step in enumerate(steps):
+        where = _format(steps[:depth]) or "scenario"
+        if not isinstance(node, list if isinstance(step, int) else dict):
+            kind = {list: "a list", dict: "a mapping"}.get(type(node), "a value")
+            raise ScenarioError(f"key path '{path}': {where} is {kind}")
+        if isinstance(step, int) and step >= len(node):
+            raise ScenarioError(
+                f"key path '{path}': index {step} out of range; {where} has {len(node)} entries"
+            )
+        if depth < len(steps) - 1:
+            node = node[step] if isinstance(step, int) else node.setdefault(step, {})
+    node[steps[-1]] = value
+    return steps
 
 
-def _check_schema(path: str, value, schema) -> None:
-    """Names the key path of the first unknown key or mistyped value.
+def _format(steps: list[str | int]) -> str:
+    return "".join(f"[{s}]" if isinstance(s, int) else f".{s}" for s in steps)[1:]
 
-    Drake's loader rejects both too, but without saying where (or, for a
-    string in a number field, with a bare ValueError).
-    """
-    where = path or "scenario"
-    fields = _fields(schema)
-    if fields is not None:
-        if not isinstance(value, dict):
-            raise ScenarioError(f"{where}: {value!r}; accepted: a mapping of {', '.join(fields)}")
-        for key, item in value.items():
-            if key not in fields:
-                raise ScenarioError(
-                    f"{path + '.' if path else ''}{key}: unknown key; accepted: {', '.join(fields)}"
-                )
-            _check_schema(f"{path + '.' if path else ''}{key}", item, fields[key])
+
+# --- Bounds and accepted values of every field ------------------------------------------
+
+
+@dataclass(frozen=True)
+class Range:
+    """Numbers from low to high; an open end excluded."""
+
+    low: float = 0.0
+    high: float = math.inf
+    low_open: bool = False
+    high_open: bool = False
+
+    def accepts(self, x) -> bool:
+        above = x > self.low if self.low_open else x >= self.low
+        return above and (x < self.high if self.high_open else x <= self.high)
+
+    def __str__(self) -> str:
+        if self.high == math.inf:
+            return f"a number {'>' if self.low_open else '>='} {self.low:g}"
+        left, right = "(["[not self.low_open], ")]"[not self.high_open]
+        return f"a number in {left}{self.low:g}, {self.high:g}{right}"
+
+
+INTERVAL = "interval"  # two numbers [low, high] with low < high
+POSITIVE, NON_NEGATIVE, FRACTION = Range(low_open=True), Range(), Range(high=1.0)
+
+# What the values at some key paths accept: a Range (of each entry of a list too), a length
+# n (a list of n entries), INTERVAL or a tuple of accepted strings. The key paths are
+# patterns separated by spaces, '*' standing for any part of a name and '[*]' for any list
+# index. Checked in this order (tests/test_config.py: every pattern names a key).
+RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
+    (("scripted", "reactive"), "human.mode"),
+    (("left", "right"), "human.pulls[*].hand"),
+    (("velocity", "path"), "human.reactive.guide"),
+    (("tangent", "interaction"), "advancement.law"),
+    (("hands", "time"), "standup.trigger"),
+    (SOLVERS, "controller.qp_solver"),
+    (tuple(GetIntegrationSchemes()), "simulator.integration_scheme"),
+    (("point", "hydroelastic", "hydroelastic_with_fallback"), "plant.contact_model"),
+    (("", "tamsi", "sap", "similar", "lagged"), "plant.discrete_contact_approximation"),
+    (("triangle", "polygon"), "plant.contact_surface_representation"),
+    (
+        POSITIVE,
+        "duration_s log_period_s controller_period_s simulator.max_step_size "
+        "robot.effort_limit_Nm robot.visual_max_faces visualization.*period_s "
+        "human.pulls[*].duration_s human.reactive.duration_s human.reactive.force_cap_N "
+        "human.reactive.pace_mps advancement.eps advancement.psi_ddot_filter_s "
+        "standup.segment_psi standup.standing_com_height_m standup.update_period_s "
+        "controller.momentum_weight controller.*_time_constant_s "
+        "controller.joint_limit_horizon_s controller.*friction_coefficient* "
+        "controller.*_max_normal_force_N controller.torque_limit_Nm controller.help_* "
+        "controller.mass_scale_bounds "
+        "fall.max_com_horizontal_m perturbation.pushes[*].duration_s perturbation.*_scale "
+        "perturbation.hand_wrench_noise_period_s plant.penetration_allowance "
+        "plant.stiction_tolerance simulator.accuracy",
+    ),
+    (
+        NON_NEGATIVE,
+        "plant.time_step human.pulls[*].start_s human.pulls[*].ramp_s "
+        "human.reactive.start_s human.reactive.ramp_s human.reactive.stiffness_N_per_m "
+        "human.reactive.damping_Ns_per_m human.reactive.travel_m "
+        "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
+        "human.reactive.ease_com_rise_m advancement.alpha_*_mps2 advancement.lag_tolerance_m "
+        "standup.*_s standup.*_N standup.com_ahead_of_heels_m controller.*_weight "
+        "controller.*weight_by_joint.* controller.*_kp_* controller.*_kd_* controller.*_ki_* "
+        "controller.*_damping_ratio controller.posture_limit_margin_rad controller.*_N "
+        "controller.lean_max_* controller.mass_estimation_filter_s seat_hold.* "
+        "fall.max_qp_failure_streak_s "
+        "perturbation.pushes[*].start_s perturbation.hand_wrench_noise_N "
+        "perturbation.noise_seed plant.sap_near_rigid_threshold simulator.target_realtime_rate "
+        "simulator.start_time fall.min_root_height_m",
+    ),
+    (Range(low=1.0), "advancement.psi_dot_upper"),
+    (Range(high=1.0, high_open=True), "advancement.taper_from_progress"),
+    (Range(high=1.0, high_open=True), "controller.stance_from_progress"),
+    (
+        FRACTION,
+        "standup.guard_off_ratio standup.reseat_above_thigh_load "
+        "controller.stance_vertical_weight_scale",
+    ),
+    (Range(1.0, 4.0), "controller.seat_hinge_from_state controller.lean_states"),
+    (2, "human.reactive.path_xz_m[*]"),
+    (
+        3,
+        "initial.base_* visualization.*_xyz_m chair.xyz_m human.pulls[*].force_N "
+        "human.reactive.target_velocity_mps standup.segment_psi standup.state*_com_delta_m "
+        "controller.com_kp_* perturbation.pushes[*].force_N",
+    ),
+    (4, "controller.base_pitch_by_state_rad"),
+    (
+        INTERVAL,
+        "human.reactive.ease_com_rise_m controller.*_cop_*_m controller.mass_scale_bounds",
+    ),
+]
+
+
+def _pattern(rule: str) -> re.Pattern:
+    text = re.escape(rule).replace(r"\[\*\]", r"\[\d+\]").replace(r"\*", r"[^.\[]*")
+    return re.compile(text)
+
+
+_COMPILED = [(_pattern(rule), accepted) for accepted, rules in RULES for rule in rules.split()]
+
+
+def _nodes(data, steps: tuple = (), leaves: bool = False) -> Iterator[tuple[list, object]]:
+    """(key path steps, value) of every node of plain data (leaves: of every leaf only;
+    an empty list is a leaf)."""
+    kind = dict if isinstance(data, dict) else list if isinstance(data, list) else None
+    items = list(data.items() if kind is dict else enumerate(data) if kind else ())
+    if steps and not (leaves and items):
+        yield list(steps), data
+    for key, value in items:
+        yield from _nodes(value, (*steps, key), leaves)
+
+
+def _check(key: str, value, accepted) -> None:
+    if value is None:  # an optional value left out
         return
-    origin = typing.get_origin(schema)
-    args = typing.get_args(schema)
-    if origin is list:
-        if not isinstance(value, list):
-            raise ScenarioError(f"{where}: {value!r}; accepted: a list")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ScenarioError(f"{key}: {value} is not finite; accepted: a finite number")
+    if isinstance(value, list) and isinstance(accepted, Range | tuple):
         for i, item in enumerate(value):
-            _check_schema(f"{path}[{i}]", item, args[0])
-    elif origin is dict:
-        if not isinstance(value, dict):
-            raise ScenarioError(f"{where}: {value!r}; accepted: a mapping")
-        for key, item in value.items():
-            _check_schema(f"{path}.{key}", item, args[1])
-    elif origin in (typing.Union, getattr(__import__("types"), "UnionType", None)):
-        if value is not None:
-            _check_schema(path, value, next(a for a in args if a is not type(None)))
-    elif schema is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ScenarioError(f"{where}: {value!r}; accepted: {_type_name(float)}")
-    elif schema in (int, bool, str):
-        if not isinstance(value, schema) or (schema is int and isinstance(value, bool)):
-            raise ScenarioError(f"{where}: {value!r}; accepted: {_type_name(schema)}")
-
-
-def _check_finite(prefix: str, obj) -> None:
-    if isinstance(obj, bool):
-        return
-    if isinstance(obj, float):
-        if not math.isfinite(obj):
-            raise ScenarioError(f"{prefix}: {obj} is not finite; accepted: a finite number")
-    elif isinstance(obj, (list, tuple)):
-        for i, item in enumerate(obj):
-            _check_finite(f"{prefix}[{i}]", item)
-    elif isinstance(obj, dict):
-        for key, item in obj.items():
-            _check_finite(f"{prefix}.{key}", item)
-    elif (fields := _fields(type(obj))) is not None:
-        for name in fields:
-            _check_finite(f"{prefix}.{name}" if prefix else name, getattr(obj, name))
+            _check(f"{key}[{i}]", item, accepted)
+    elif isinstance(accepted, tuple):
+        if value not in accepted:
+            raise ScenarioError(f"{key}: '{value}' unknown; accepted: {' | '.join(accepted)}")
+    elif isinstance(accepted, int):
+        if len(value) != accepted:
+            raise ScenarioError(
+                f"{key}: {len(value)} values; accepted: a list of {accepted} numbers"
+            )
+    elif accepted == INTERVAL:
+        if len(value) != 2 or not value[0] < value[1]:
+            raise ScenarioError(f"{key}: {value}; accepted: [low, high] with low < high")
+    elif accepted is not None and not accepted.accepts(value):
+        raise ScenarioError(f"{key}: {value}; accepted: {accepted}")
 
 
 def validate(scenario: Scenario) -> None:
     """Checks what the types alone cannot; raises ScenarioError (one line)."""
     from drake_standup.robot import robot_names
 
-    _check_finite("", scenario)
+    for steps, value in _nodes(_plain(scenario)):
+        key = _format(steps)
+        _check(key, value, None)
+        for pattern, accepted in _COMPILED:
+            if pattern.fullmatch(key):
+                _check(key, value, accepted)
     if scenario.robot.model not in robot_names():
         raise ScenarioError(
             f"robot.model: unknown model '{scenario.robot.model}'; "
             f"accepted: {', '.join(robot_names())}"
         )
-    _positive("duration_s", scenario.duration_s, allow_zero=False)
-    _positive("plant.time_step", scenario.plant.time_step, allow_zero=True)
-    _positive("robot.effort_limit_Nm", scenario.robot.effort_limit_Nm)
-    _positive("log_period_s", scenario.log_period_s, allow_zero=False)
-    _positive("controller_period_s", scenario.controller_period_s)
-    _positive("simulator.max_step_size", scenario.simulator.max_step_size)
     _check_rates(scenario.plant.time_step, scenario.controller_period_s)
-    _positive("visualization.publish_period_s", scenario.visualization.publish_period_s)
-    _positive("robot.visual_max_faces", scenario.robot.visual_max_faces)
-    if not _resolve(scenario.chair.file).is_file():
+    if not chair_file(scenario.chair.file).is_file():
         raise ScenarioError(
             f"chair.file: '{scenario.chair.file}' not found; accepted: an SDF file path "
-            "(relative to the repository or absolute), e.g. models/chair.sdf"
+            "(absolute or relative to the current directory), or models/chair.sdf"
         )
-    _length("initial.base_xyz_m", scenario.initial.base_xyz_m, 3)
-    _length("initial.base_rpy_rad", scenario.initial.base_rpy_rad, 3)
-    _validate_human(scenario.human)
-    _validate_advancement(scenario.advancement)
-    _validate_standup(scenario.standup)
-    _validate_perturbation(scenario.perturbation)
+    for i, pull in enumerate(scenario.human.pulls):
+        if 2 * pull.ramp_s > pull.duration_s:
+            raise ScenarioError(
+                f"human.pulls[{i}].ramp_s: {pull.ramp_s}; accepted: at most half of "
+                f"duration_s ({pull.duration_s / 2})"
+            )
+    _validate_path(scenario.human.reactive)
 
 
 def _check_rates(time_step: float, period_s: float) -> None:
@@ -683,46 +785,6 @@ def _check_rates(time_step: float, period_s: float) -> None:
         )
 
 
-def _resolve(path: str) -> Path:
-    """A path from a scenario: absolute, or relative to the repository."""
-    p = Path(path)
-    return p if p.is_absolute() else REPO_ROOT / p
-
-
-def _length(key: str, value: list, n: int) -> None:
-    if len(value) != n:
-        raise ScenarioError(f"{key}: {len(value)} values; accepted: a list of {n} numbers")
-
-
-def _choice(key: str, value: str, accepted: tuple[str, ...]) -> None:
-    if value not in accepted:
-        raise ScenarioError(f"{key}: '{value}' unknown; accepted: {' | '.join(accepted)}")
-
-
-def _validate_human(human: HumanConfig) -> None:
-    _choice("human.mode", human.mode, ("scripted", "reactive"))
-    for i, pull in enumerate(human.pulls):
-        key = f"human.pulls[{i}]"
-        _choice(f"{key}.hand", pull.hand, ("left", "right"))
-        _positive(f"{key}.start_s", pull.start_s, allow_zero=True)
-        _positive(f"{key}.duration_s", pull.duration_s)
-        _positive(f"{key}.ramp_s", pull.ramp_s, allow_zero=True)
-        if 2 * pull.ramp_s > pull.duration_s:
-            raise ScenarioError(
-                f"{key}.ramp_s: {pull.ramp_s}; accepted: at most half of duration_s "
-                f"({pull.duration_s / 2})"
-            )
-        _length(f"{key}.force_N", pull.force_N, 3)
-    r = human.reactive
-    _choice("human.reactive.guide", r.guide, ("velocity", "path"))
-    for name in ("start_s", "ramp_s", "stiffness_N_per_m", "damping_Ns_per_m", "travel_m"):
-        _positive(f"human.reactive.{name}", getattr(r, name), allow_zero=True)
-    _positive("human.reactive.duration_s", r.duration_s)
-    _positive("human.reactive.force_cap_N", r.force_cap_N)
-    _length("human.reactive.target_velocity_mps", r.target_velocity_mps, 3)
-    _validate_path(r)
-
-
 def _validate_path(r: ReactiveHumanConfig) -> None:
     key = "human.reactive"
     if not r.path_xz_m:
@@ -731,92 +793,13 @@ def _validate_path(r: ReactiveHumanConfig) -> None:
         )
     previous = [0.0, 0.0]
     for i, point in enumerate(r.path_xz_m):
-        _length(f"{key}.path_xz_m[{i}]", point, 2)
         if math.dist(point, previous) < 1e-3:
             raise ScenarioError(
                 f"{key}.path_xz_m[{i}]: {point}; accepted: a waypoint at least 1 mm from "
                 f"the one before ({previous}; the path starts at [0, 0])"
             )
         previous = point
-    _positive(f"{key}.path_corner_radius_m", r.path_corner_radius_m, allow_zero=True)
-    _positive(f"{key}.pace_mps", r.pace_mps)
-    _positive(f"{key}.lead_min_m", r.lead_min_m, allow_zero=True)
     if not r.lead_max_m >= r.lead_min_m:
         raise ScenarioError(
             f"{key}.lead_max_m: {r.lead_max_m}; accepted: a number >= lead_min_m ({r.lead_min_m})"
-        )
-    _length(f"{key}.ease_com_rise_m", r.ease_com_rise_m, 2)
-    low, high = r.ease_com_rise_m
-    if not 0.0 <= low < high:
-        raise ScenarioError(
-            f"{key}.ease_com_rise_m: {r.ease_com_rise_m}; accepted: [start, end] with "
-            "0 <= start < end, m"
-        )
-
-
-def _validate_advancement(adv: AdvancementConfig) -> None:
-    _choice("advancement.law", adv.law, ("tangent", "interaction"))
-    if adv.psi_dot_upper < 1.0:
-        raise ScenarioError(
-            f"advancement.psi_dot_upper: {adv.psi_dot_upper}; accepted: a number >= 1"
-        )
-    _positive("advancement.eps", adv.eps)
-    _positive("advancement.alpha_min_mps2", adv.alpha_min_mps2, allow_zero=True)
-    _positive("advancement.lag_tolerance_m", adv.lag_tolerance_m, allow_zero=True)
-    _positive("advancement.alpha_full_mps2", adv.alpha_full_mps2, allow_zero=True)
-    if not 0.0 <= adv.taper_from_progress < 1.0:
-        raise ScenarioError(
-            f"advancement.taper_from_progress: {adv.taper_from_progress}; accepted: [0, 1)"
-        )
-    _positive("advancement.psi_ddot_filter_s", adv.psi_ddot_filter_s)
-
-
-def _validate_standup(st: StandupConfig) -> None:
-    _choice("standup.trigger", st.trigger, ("hands", "time"))
-    _length("standup.segment_psi", st.segment_psi, 3)
-    for i, value in enumerate(st.segment_psi):
-        _positive(f"standup.segment_psi[{i}]", value)
-    _length("standup.state2_com_delta_m", st.state2_com_delta_m, 3)
-    _length("standup.state3_com_delta_m", st.state3_com_delta_m, 3)
-    for name in (
-        "balance_time_s",
-        "hand_force_threshold_N",
-        "hindering_force_threshold_N",
-        "feet_force_2to3_N",
-        "min_time_state2_s",
-        "foot_force_3to4_N",
-        "min_time_state3_s",
-        "seat_release_s",
-        "seat_unload_s",
-        "force_filter_time_constant_s",
-        "guard_dwell_s",
-    ):
-        _positive(f"standup.{name}", getattr(st, name), allow_zero=True)
-    _positive("standup.standing_com_height_m", st.standing_com_height_m)
-    if not 0.0 <= st.guard_off_ratio <= 1.0:
-        raise ScenarioError(
-            f"standup.guard_off_ratio: {st.guard_off_ratio}; accepted: a number in [0, 1]"
-        )
-    _positive("standup.update_period_s", st.update_period_s)
-
-
-def _positive(key: str, value: float, allow_zero: bool = False) -> None:
-    if not (value >= 0 if allow_zero else value > 0):
-        accepted = "a number >= 0" if allow_zero else "a number > 0"
-        raise ScenarioError(f"{key}: {value}; accepted: {accepted}")
-
-
-def _validate_perturbation(pert: PerturbationConfig) -> None:
-    for i, push in enumerate(pert.pushes):
-        key = f"perturbation.pushes[{i}]"
-        _positive(f"{key}.start_s", push.start_s, allow_zero=True)
-        _positive(f"{key}.duration_s", push.duration_s)
-        _length(f"{key}.force_N", push.force_N, 3)
-    _positive("perturbation.mass_scale", pert.mass_scale)
-    _positive("perturbation.friction_scale", pert.friction_scale)
-    _positive("perturbation.hand_wrench_noise_N", pert.hand_wrench_noise_N, allow_zero=True)
-    _positive("perturbation.hand_wrench_noise_period_s", pert.hand_wrench_noise_period_s)
-    if pert.noise_seed < 0:
-        raise ScenarioError(
-            f"perturbation.noise_seed: {pert.noise_seed}; accepted: an integer >= 0"
         )

@@ -192,8 +192,9 @@ class ControllerConfig:
     # thighs (measured). m.
     seat_cop_x_m: list[float] = field(default_factory=lambda: [-0.11, -0.06])
     seat_cop_y_m: list[float] = field(default_factory=lambda: [-0.05, 0.05])
-    # Joint torque saturation (SPEC 3). N m.
-    torque_limit_Nm: float = 60.0
+    # Joint torque saturation, N m. None: the actuators' effort limit in the plant
+    # (robot.effort_limit_Nm, SPEC 3); a number: a tighter limit of the controller's own.
+    torque_limit_Nm: float | None = None
     # ||xd_dot|| below which the helpful part of the pull fades out (smoothstep): the
     # standing robot compensates the whole pull (SPEC 7). m/s.
     help_fade_speed_mps: float = 0.02
@@ -273,6 +274,15 @@ class ControllerConfig:
             for joint in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
         }
     )
+    # The robot weighs itself while seated (state 1): the pads' measured vertical force
+    # plus the hands' (m g = sum F_z, the robot at rest) low-pass filtered with this time
+    # constant, and the controller's model scaled to the estimate (every body's mass
+    # alike, control/terms.py). With the nominal model a robot 15 % lighter rose 2 cm ahead
+    # of its reference onto locked knees, and one 15 % heavier stalled in state 2 with the
+    # hips on their stop (measured). 0: the nominal model throughout. s.
+    mass_estimation_filter_s: float = 0.3
+    # Bounds of the estimated mass scale (estimate / model).
+    mass_scale_bounds: list[float] = field(default_factory=lambda: [0.7, 1.3])
     # QP solver: daqp (measured fastest, exact equalities), or Drake's osqp / clarabel.
     qp_solver: str = "daqp"
 
@@ -356,6 +366,7 @@ class ControllerTick:
     posture: np.ndarray  # next value of the posture state (see __init__)
     lean_W: np.ndarray  # next value of the lean state, m
     height_integral: float  # next value of the stance's height integral, m s
+    mass_scale: tuple[float, float]  # next value of the mass estimate's state
     unloading: np.ndarray  # next value of the unloading memory (see __init__)
     inputs_s: float  # evaluating the input ports (and the upstream systems behind them)
     kinematics_s: float
@@ -385,6 +396,7 @@ class WholeBodyController(LeafSystem):
         "lean_x_m",  # the CoM target's lean against the pull, x
         "lean_y_m",  # ... and y, m
         "qp_relaxed",  # ticks solved only with the contacts relaxed, since the start
+        "mass_scale",  # the model's mass scale, estimated while seated (1: nominal)
     )
     # Columns of timing_s().
     TIMING = ("inputs_s", "kinematics_s", "assembly_s", "solve_s", "total_s")
@@ -404,6 +416,10 @@ class WholeBodyController(LeafSystem):
         self._config = config
         self._period_s = period_s
         self._B = plant.MakeActuationMatrix()
+        actuators = plant.GetJointActuatorIndices(robot.model_instance)
+        self._torque_limit_Nm = config.torque_limit_Nm or min(
+            plant.get_joint_actuator(i).effort_limit() for i in actuators
+        )
         self._nv, self._nu = nv, nu = self._B.shape
         self.contact_specs = _contact_specs(plant, robot, config)
         held_frames = [spec.frame for spec in self.contact_specs if spec.constrained]
@@ -442,8 +458,10 @@ class WholeBodyController(LeafSystem):
             hold_points_m={spec.frame: spec.hold_point_m for spec in self.contact_specs},
         )
         # The weight's wrench about the CoM, [0; m g], N.
-        self._W_gravity = np.zeros(6)
-        self._W_gravity[3:] = self._kinematics.mass_kg * plant.gravity_field().gravity_vector()
+        self._gravity_W = plant.gravity_field().gravity_vector()
+        self._nominal_weight_N = -self._kinematics.nominal_mass_kg * self._gravity_W[2]
+        self._W_gravity = np.zeros(6)  # updated in place with the mass estimate
+        self._W_gravity[3:] = self._kinematics.mass_kg * self._gravity_W
         # Held rows of the seat's acceleration from seat_hinge_from_state: all but the
         # pitch about the hip axis (alpha_y in C).
         self._hinged_rows = np.ones(WRENCH_SIZE, dtype=bool)
@@ -462,6 +480,9 @@ class WholeBodyController(LeafSystem):
         # Measured normal forces on the buttocks, left and right thigh pads (N), in
         # CONTACTS' order of the seat contacts; unconnected (unit tests): not used.
         self._seat_pads_port = self.DeclareVectorInputPort("seat_pad_normal_forces_N", 3)
+        # The measured vertical force on all the robot's pads, N; unconnected (unit
+        # tests): the nominal model throughout.
+        self._support_port = self.DeclareVectorInputPort("pads_vertical_force_N", 1)
         # Unconnected (unit tests): taken as 1, the segment finished.
         self._progress_port = self.DeclareVectorInputPort("path_progress", 1)
         self._actuation = self.DeclareDiscreteState(nu)
@@ -471,6 +492,8 @@ class WholeBodyController(LeafSystem):
         self._posture = self.DeclareDiscreteState(2 + 2 * nu)
         self._lean = self.DeclareDiscreteState(3)  # the CoM target's lean, m
         self._height_integral = self.DeclareDiscreteState(1)  # stance, int (z_d - z), m s
+        # [the model's mass scale, estimated while seated; 1 once the stand-up has begun].
+        self._mass_scale = self.DeclareDiscreteState(np.array([1.0, 0.0]))
         # Unloading memory of the seat and thighs: [the commanded loads their unloading
         # started from (3), their last commanded loads (3)], N.
         self._unloading = self.DeclareDiscreteState(6)
@@ -479,6 +502,11 @@ class WholeBodyController(LeafSystem):
         # Initialization event: the plant's first step already sees computed torques.
         self.DeclareInitializationDiscreteUpdateEvent(self._Update)
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
+
+    @property
+    def nominal_mass_kg(self) -> float:
+        """The robot's mass in the model the controller was built with, kg."""
+        return self._kinematics.nominal_mass_kg
 
     # --- Timing --------------------------------------------------------------------
 
@@ -511,11 +539,26 @@ class WholeBodyController(LeafSystem):
         standup_state, seat_scale, feet_scale = plan[:3].tolist()
         standup_state = min(max(int(round(standup_state)), 1), 4)
         program = self._program((seat_scale > 0.0, feet_scale > 0.0))
+        state = context.get_discrete_state()
+        mass_scale, began = state.get_value(self._mass_scale)
+        began = began or standup_state > 1
+        tau_m = self._config.mass_estimation_filter_s
+        if not began and tau_m > 0.0 and self._support_port.HasValue(context):
+            # Weighing while first seated: at rest m g = the pads' and the hands' vertical
+            # forces. Frozen from the first stand-up on: a robot sat back by a hindering
+            # pull rocks on the seat, and weighing it then put the model 3 % off (measured).
+            weight_N = float(self._support_port.Eval(context)[0]) + F_hand_W[5] + F_hand_W[11]
+            measured = weight_N / self._nominal_weight_N
+            lo, hi = self._config.mass_scale_bounds
+            mass_scale += min(self._period_s / tau_m, 1.0) * (measured - mass_scale)
+            mass_scale = min(max(mass_scale, lo), hi)
+        if mass_scale != self._kinematics.mass_scale:
+            self._kinematics.set_mass_scale(mass_scale)
+            self._W_gravity[3:] = self._kinematics.mass_kg * self._gravity_W
         pulled = bool(F_hand_W.any())
         terms = self._kinematics.calc(x, program.frames, self._hands if pulled else ())
         t_kinematics = time.perf_counter()
 
-        state = context.get_discrete_state()
         references = self._references.calc(
             terms,
             standup_state,
@@ -532,7 +575,7 @@ class WholeBodyController(LeafSystem):
             self._seat_pads_port.Eval(context) if self._seat_pads_port.HasValue(context) else None
         )
         commands = self._contact_commands(
-            program, references.state.seat_hinged, plan, unloading[:3], measured
+            program, references.state.seat_hinged, plan, unloading[:3], measured, bool(began)
         )
         t_tasks = time.perf_counter()
         solution = program.qp.solve(terms, references, commands)
@@ -549,6 +592,7 @@ class WholeBodyController(LeafSystem):
             posture=references.next_posture,
             lean_W=references.lean_W,
             height_integral=references.next_height_integral,
+            mass_scale=(mass_scale, float(began)),
             unloading=unloading,
             inputs_s=t_inputs - t_start,
             kinematics_s=t_kinematics - t_inputs,
@@ -598,7 +642,7 @@ class WholeBodyController(LeafSystem):
             qp = WholeBodyQp(
                 contact_map,
                 self._B,
-                torque_limit_Nm=config.torque_limit_Nm,
+                torque_limit_Nm=self._torque_limit_Nm,
                 torque_weight=config.torque_weight,
                 wrench_weight=config.wrench_weight,
                 acceleration_weight=config.acceleration_weight,
@@ -653,6 +697,7 @@ class WholeBodyController(LeafSystem):
         plan: np.ndarray,
         unload_from_N: np.ndarray,
         measured_N: np.ndarray | None = None,
+        resat: bool = False,
     ) -> ContactCommands:
         """Normal-force bounds from the plan: seat and thighs in seat_scale * [f_min,
         f_max_seat] while seated, in [0, fraction * the load they unload from] while they
@@ -690,7 +735,12 @@ class WholeBodyController(LeafSystem):
         if np.isfinite(plan[3]):  # the buttocks unloading
             hold = "free"
         else:
-            hold = "hinged" if seat_hinged else "held"
+            # Sat back by a hindering pull (state 1 after a stand-up began), the pelvis
+            # still pitched forward: hinged, so that the base task brings it upright.
+            # Held, the QP pinned a pelvis that was pitching back onto the chair, and
+            # it rocked +-0.45 rad between buttocks and thighs until the feet slid
+            # (measured).
+            hold = "hinged" if (seat_hinged or resat) else "held"
         return ContactCommands(min_normal_force_N, max_normal_force_N, program.partially_held[hold])
 
     def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
@@ -707,6 +757,7 @@ class WholeBodyController(LeafSystem):
         discrete_state.set_value(self._lean, tick.lean_W)
         discrete_state.set_value(self._height_integral, [tick.height_integral])
         discrete_state.set_value(self._unloading, tick.unloading)
+        discrete_state.set_value(self._mass_scale, tick.mass_scale)
         total_s = time.perf_counter() - t_start
         diagnostics = np.empty(len(self.DIAGNOSTICS))
         f_par = tick.helpful_force_W
@@ -716,6 +767,7 @@ class WholeBodyController(LeafSystem):
         diagnostics[10] = float(np.abs(solution.slack).max()) if solution.slack.size else 0.0
         diagnostics[11:13] = tick.lean_W[:2]
         diagnostics[13] = state.get_value(self._diagnostics)[13] + float(solution.relaxed)
+        diagnostics[14] = tick.mass_scale[0]
         discrete_state.set_value(self._diagnostics, diagnostics)
         self._timing.append(
             (tick.inputs_s, tick.kinematics_s, tick.assembly_s, solution.solve_s, total_s)

@@ -1,6 +1,6 @@
 """Time-step convergence study (issue 11): how coarse may the plant and controller step?
 
-python -m drake_standup.convergence [--out DIR] [--workers N] [--scenarios NAME ...]
+drake-standup convergence [--out DIR] [--workers N] [--scenarios NAME ...]
     [--steps-ms H ...] [--fresh] [--docs DIR]
 
 A study, not a test. It simulates scenarios/NAME.yaml (assisted, unassisted,
@@ -771,7 +771,8 @@ def run_study(
     progress: bool = True,
 ) -> StudyResult:
     """Simulates what OUT/runs/ does not hold yet, compares, chooses, reports."""
-    from drake_standup.sweep import run_on_cluster, write_json
+    from drake_standup.cluster import run_on_cluster
+    from drake_standup.outputs import write_json
 
     out_dir = Path(out_dir)
     runs_dir = out_dir / "runs"
@@ -873,10 +874,11 @@ def _inf_as_text(x):
 # --- Command line -------------------------------------------------------------
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, prog: str = "python -m drake_standup.convergence") -> int:
     parser = OneLineErrorParser(
-        prog="python -m drake_standup.convergence",
+        prog=prog,
         description=__doc__,
+        epilog="example: drake-standup convergence --scenarios seated --steps-ms 1 4 --out out/c",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(

@@ -18,7 +18,7 @@ from pydrake.systems.primitives import (
 )
 
 from drake_standup.advancement import TrajectoryAdvancement
-from drake_standup.config import Scenario
+from drake_standup.config import Scenario, ScenarioError
 from drake_standup.contacts import ContactForceReporter
 from drake_standup.controller import WholeBodyController
 from drake_standup.human import HumanWrenchSource
@@ -123,6 +123,9 @@ def build_diagram(
         builder.Connect(advancement.GetOutputPort(name), reference.GetInputPort(name))
     builder.Connect(state_machine.GetOutputPort("segment"), reference.GetInputPort("segment"))
     builder.Connect(advancement.GetOutputPort("psi"), state_machine.GetInputPort("psi"))
+    builder.Connect(
+        state_machine.GetOutputPort("standup_state"), advancement.GetInputPort("standup_state")
+    )
     builder.Connect(sensing.GetOutputPort("com_W"), state_machine.GetInputPort("com_W"))
     builder.Connect(sensing.GetOutputPort("heel_x_W"), state_machine.GetInputPort("heel_x_W"))
     builder.Connect(reporter.get_output_port(), state_machine.GetInputPort("pad_forces_W"))
@@ -132,10 +135,13 @@ def build_diagram(
 
     controller_system = None
     if controller == "whole_body":
-        controller_system = builder.AddNamedSystem(
-            "controller",
-            WholeBodyController(plant, robot, scenario.controller, scenario.controller_period_s),
-        )
+        try:
+            whole_body = WholeBodyController(
+                plant, robot, scenario.controller, scenario.controller_period_s
+            )
+        except ValueError as err:  # a setting only the model can check: a joint's name
+            raise ScenarioError(" ".join(str(err).split())) from None
+        controller_system = builder.AddNamedSystem("controller", whole_body)
         builder.Connect(robot_state, controller_system.GetInputPort("robot_state"))
         builder.Connect(
             reference.GetOutputPort("com_reference"),
@@ -158,6 +164,14 @@ def build_diagram(
         builder.Connect(reporter.get_output_port(), seat_pads.get_input_port())
         builder.Connect(
             seat_pads.get_output_port(), controller_system.GetInputPort("seat_pad_normal_forces_N")
+        )
+        # The vertical force on all the robot's pads (its weight while it sits still).
+        total = np.zeros((1, 3 * len(pad_names)))
+        total[0, 2::3] = 1.0
+        support = builder.AddNamedSystem("pads_vertical_force", MatrixGain(total))
+        builder.Connect(reporter.get_output_port(), support.get_input_port())
+        builder.Connect(
+            support.get_output_port(), controller_system.GetInputPort("pads_vertical_force_N")
         )
         builder.Connect(
             controller_system.GetOutputPort("actuation"), plant.get_actuation_input_port(instance)

@@ -34,6 +34,15 @@ def write_metrics(path: Path, metrics: dict) -> None:
     path.write_text(json.dumps(json_safe(metrics), indent=2) + "\n")
 
 
+def write_json(path: Path, data) -> None:
+    """data as JSON (json_safe), written whole or not at all (a temporary file
+    renamed over path), its folder made if needed."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(json_safe(data), indent=1) + "\n")
+    tmp.replace(path)
+
+
 # --- signals.npz ---------------------------------------------------------------
 
 # Version of signals.npz's layout; bump it (and keep load_signals reading the

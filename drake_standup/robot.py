@@ -44,9 +44,13 @@ from pydrake.multibody.tree import (
 )
 
 from drake_standup.meshes import cache_dir, converted_obj
+from drake_standup.resources import model_file
 
 DEFAULT_MODEL = "iCubGazeboV2_5"
-CONTACT_FILE = Path(__file__).resolve().parent.parent / "models" / "icub_contact.yaml"
+# Torque saturation of the authors' controller (SPEC 3): every actuator's effort limit,
+# which the whole-body controller reads from the plant. N m.
+EFFORT_LIMIT_NM = 60.0
+CONTACT_FILE = model_file("icub_contact.yaml")
 
 
 class ModelError(ValueError):
@@ -328,7 +332,7 @@ def add_icub(
     *,
     reduce: bool = True,
     visuals: bool = True,
-    effort_limit_Nm: float = 60.0,
+    effort_limit_Nm: float = EFFORT_LIMIT_NM,
     pd_gains: tuple[float, float] | None = None,
     contact: ContactModel | None = None,
     visual_max_faces: int = 1000,

@@ -14,11 +14,10 @@ from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Context, DiagramBuilder
 
-from drake_standup.config import REPO_ROOT, Scenario, _resolve
+from drake_standup.config import Scenario, chair_file
 from drake_standup.perturbations import scale_friction
+from drake_standup.resources import model_file
 from drake_standup.robot import Robot, add_icub, set_joint_positions
-
-MODELS_DIR = REPO_ROOT / "models"
 
 
 class _NoDeformableHalfSpaceWarning(logging.Filter):
@@ -58,8 +57,8 @@ def add_scene(
         visual_max_faces=scenario.robot.visual_max_faces,
     )
     parser = Parser(plant)
-    (floor,) = _add_sdf(parser, MODELS_DIR / "floor.sdf")
-    (chair,) = _add_sdf(parser, _resolve(scenario.chair.file))
+    (floor,) = _add_sdf(parser, model_file("floor.sdf"))
+    (chair,) = _add_sdf(parser, chair_file(scenario.chair.file))
     world = plant.world_frame()
     plant.WeldFrames(world, plant.GetFrameByName("floor", floor))
     plant.WeldFrames(

@@ -35,8 +35,6 @@ from drake_standup.scene import erect_com_height_m, set_seated_state
 if TYPE_CHECKING:
     from drake_standup.live import LiveSession
 
-GRAVITY_MPS2 = 9.81
-
 
 @dataclass
 class RunResult:
@@ -271,6 +269,8 @@ def _simulate_one(
     except RuntimeError as err:
         failure_reason = "simulation error: " + " ".join(str(err).split())[:300]
     wall_time_s = time.perf_counter() - t_wall
+    if live is not None and failure_reason is None:
+        failure_reason = live.fell  # a fall that no Reset undid
     if bar is not None:
         bar.close()
 
@@ -278,7 +278,10 @@ def _simulate_one(
     if built.controller is not None:
         result.controller_timing_s = built.controller.timing_s()
     sim_time_s = root_context.get_time()
-    standing = result.metrics.get("standing_at_end", False)
+    # Success: standing at the end, having stood (standup_time_s: standing held 0.2 s).
+    standing = result.metrics.get("standing_at_end", False) and (
+        result.metrics.get("standup_time_s") is not None
+    )
     if failure_reason is None and built.controller is not None and not standing:
         if (
             result.metrics.get("held_back_s", 0.0) > 0.0
@@ -320,6 +323,10 @@ def _simulate_one(
         path = out_dir / "signals.npz"
         outputs.write_signals(path, result.signals)
         result.files["signals"] = path
+        # Every value simulated, as a scenario file (--scenario reruns it).
+        path = out_dir / "scenario.yaml"
+        path.write_text(yaml_dump_typed(scenario))
+        result.files["scenario"] = path
         # The figures draw the arrays signals.npz holds (the round trip is tested).
         entries = result.metrics.get("state_entry_times_s", [])
         path = out_dir / "figure_advancement.png"
@@ -453,6 +460,8 @@ def make_signals(built: StandupDiagram, root_context) -> dict[str, np.ndarray]:
         signals["joint_limit_slack"] = diagnostics[:, 10]
         signals["qp_relaxed"] = diagnostics[:, 13].astype(np.int64)
         signals["com_lean_W"] = np.c_[diagnostics[:, 11:13], np.zeros(len(t))]
+        # The controller's model mass over the nominal, as it weighed the robot seated.
+        signals["model_mass_scale"] = diagnostics[:, 14]
         # What the QP asked of each of its contacts (NaN where it failed): against
         # pad_normal_force_N it shows where the controller's contact model is wrong.
         signals["commanded_contacts"] = np.array(WholeBodyController.CONTACTS, dtype=str)
@@ -476,7 +485,8 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
     # one (perturbation.mass_scale), whose weight the contacts carry.
     mass_kg = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
     simulated_mass_kg = plant.CalcTotalMass(plant.GetMyContextFromRoot(root_context), [instance])
-    metrics = outputs.seated_metrics(signals, weight_N=simulated_mass_kg * GRAVITY_MPS2)
+    g = -plant.gravity_field().gravity_vector()[2]
+    metrics = outputs.seated_metrics(signals, weight_N=simulated_mass_kg * g)
     metrics["robot_mass_kg"] = mass_kg
     metrics["simulated_mass_kg"] = simulated_mass_kg
     entry_times = built.state_machine.mode(
@@ -506,6 +516,11 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
     if "qp_relaxed" in signals and len(signals["time_s"]):
         # Ticks the QP was solved only with its contacts relaxed (control/qp.py).
         metrics["qp_relaxed_ticks"] = int(signals["qp_relaxed"][-1])
+    if "model_mass_scale" in signals and len(signals["time_s"]):
+        # The robot's mass as the controller estimated it (weighing itself seated).
+        metrics["model_mass_kg"] = float(
+            signals["model_mass_scale"][-1] * built.controller.nominal_mass_kg
+        )
     if "held_back_s" in signals and len(signals["time_s"]):
         # How long the stand-up waited for a pull against it to stop (state machine).
         metrics["held_back_s"] = float(signals["held_back_s"][-1])

@@ -95,6 +95,10 @@ class StandupMode:
     delta_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     guards: GuardSignals = GuardSignals()
     held_back_s: float = 0.0  # time spent waiting for a hindering pull to stop
+    # Where the CoM sat at the start: a stand-up sat back by a hindering pull returns
+    # there, so that its next state-2 segment starts where the first one did.
+    x_seated_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    hindered_until_s: float = -math.inf  # the last time a hindering pull was felt
 
     def __copy__(self) -> StandupMode:
         return self
@@ -130,7 +134,8 @@ class Measurements:
 
 def initial_mode(com0_W: np.ndarray) -> StandupMode:
     """State 1 at t = 0, holding the CoM where it starts."""
-    return StandupMode(x_start_m=tuple(float(c) for c in com0_W))
+    com0 = tuple(float(c) for c in com0_W)
+    return StandupMode(x_start_m=com0, x_seated_m=com0)
 
 
 def _low_pass(previous: tuple[float, ...], raw: tuple[float, ...], gain: float) -> tuple:
@@ -173,16 +178,22 @@ def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> Standup
     held = mode.held_back_s
     if g.hindered.on and mode.state < 4 and not math.isnan(mode.guards.t):
         held += m.t - mode.guards.t
-    mode = dataclasses.replace(mode, guards=g, held_back_s=held)
+    hindered_until = m.t if g.hindered.on else mode.hindered_until_s
+    mode = dataclasses.replace(mode, guards=g, held_back_s=held, hindered_until_s=hindered_until)
     dwell = m.t - mode.entry_times_s[mode.state - 1]
     segment_done = m.psi - mode.psi_entry >= mode.segment_psi
     hindered = g.hindered.on
-    if mode.state == 2 and hindered:
-        return _reseat(mode, m)
+    calm = not hindered and m.t - mode.hindered_until_s >= cfg.resume_after_s
+    if hindered and (
+        mode.state == 2
+        or (mode.state == 3 and seat_unloading(mode, m.t, cfg)[1] > cfg.reseat_above_thigh_load)
+    ):
+        # The thighs still on the chair: sit back and wait.
+        return _reseat(mode, m, cfg)
     if mode.state == 1:
         asked = cfg.trigger == "time" or g.hands_pulled.on or m.stand_up
         go = dwell >= cfg.balance_time_s and asked
-        go = go and not hindered
+        go = go and calm and (segment_done or not any(mode.delta_m))
     elif mode.state == 2:
         go = (
             dwell >= cfg.min_time_state2_s
@@ -196,7 +207,7 @@ def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> Standup
             and dwell >= cfg.seat_release_s  # the thighs unloaded
             and segment_done
             and g.each_foot_loaded.on
-            and not hindered
+            and calm
         )
     else:
         go = False
@@ -205,11 +216,15 @@ def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> Standup
     return _enter(mode, mode.state + 1, m, cfg)
 
 
-def _reseat(mode: StandupMode, m: Measurements) -> StandupMode:
-    """Back to state 1 from state 2 (the thighs are still on the chair): a pull against
+def _reseat(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> StandupMode:
+    """Back to state 1 from state 2, or from state 3 while the thighs still carry more
+    than reseat_above_thigh_load of their load: a pull against
     the stand-up waits seated (the paper: psi = t, nothing advances). The state-1
-    segment holds the reference where it is now (no jump); state 1's balancing time
-    runs again from now."""
+    segment starts where the reference is now (no jump) and returns to where the CoM
+    sat at the start, at the pace of the state-2 segment; state 1's balancing time runs
+    again from now, and state 2 waits for the return. Held where it was instead, the
+    next state-2 segment started from there and every later one ended its offset (6 cm
+    forward) further on: the robot stood up past its toes and fell (measured)."""
     x_now = path(mode.segment(), m.psi)[0]
     entry = [m.t] + [math.nan] * (N_STATES - 1)
     return dataclasses.replace(
@@ -217,9 +232,9 @@ def _reseat(mode: StandupMode, m: Measurements) -> StandupMode:
         state=1,
         entry_times_s=tuple(entry),
         psi_entry=m.psi,
-        segment_psi=1.0,
+        segment_psi=cfg.segment_psi[0],
         x_start_m=tuple(float(v) for v in x_now),
-        delta_m=(0.0, 0.0, 0.0),
+        delta_m=tuple(float(a - b) for a, b in zip(mode.x_seated_m, x_now, strict=True)),
     )
 
 

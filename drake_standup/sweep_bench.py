@@ -1,6 +1,6 @@
 """Sweep throughput: the same sweep on 1 worker, then on 2, in one run.
 
-python -m drake_standup.sweep_bench [--spec sweeps/assistance.yaml] [--workers 1 2]
+python -m drake_standup.sweep_bench [--spec assistance] [--workers 1 2]
                                     [--limit N] [--out DIR]
 
 A benchmark, not a test. Each worker count gets a fresh LocalCluster and a
@@ -23,15 +23,20 @@ import time
 from pathlib import Path
 
 from drake_standup.cli import OneLineErrorParser
-from drake_standup.config import REPO_ROOT
-from drake_standup.sweep import load_sweep, run_sweep, simulation_rows
+from drake_standup.sweep import run_sweep
+from drake_standup.sweep_file import load_sweep
+from drake_standup.sweep_table import simulation_rows
 
 
 def _git() -> dict:
     def run(*args: str) -> str:
         try:
             out = subprocess.run(
-                ["git", *args], cwd=REPO_ROOT, capture_output=True, text=True, check=True
+                ["git", *args],
+                cwd=Path(__file__).parent,
+                capture_output=True,
+                text=True,
+                check=True,
             )
         except (OSError, subprocess.CalledProcessError):
             return ""
@@ -46,7 +51,7 @@ def main(argv: list[str] | None = None) -> int:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--spec", type=Path, default=REPO_ROOT / "sweeps" / "assistance.yaml")
+    parser.add_argument("--spec", default="assistance", help="sweep file or shipped name")
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--limit", type=int, default=None, help="first N runs only")
     parser.add_argument("--out", type=Path, default=Path("out") / "sweep_bench")

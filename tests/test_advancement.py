@@ -91,9 +91,11 @@ def test_interaction_law_value_matches_the_authors_ratio():
     )
 
 
-def _simulate_advancement(cfg, v, omega_f, tangent, t_end):
+def _simulate_advancement(cfg, v, omega_f, tangent, t_end, standup_state=None):
     system = TrajectoryAdvancement(cfg)
     context = system.CreateDefaultContext()
+    if standup_state is not None:
+        system.GetInputPort("standup_state").FixValue(context, [standup_state])
     # CoM on its reference: the lead gate is open.
     system.GetInputPort("com_W").FixValue(context, np.zeros(3))
     system.GetInputPort("x_d_W").FixValue(context, np.zeros(3))
@@ -132,6 +134,20 @@ def test_psi_integrates_the_rate_that_follows_the_law():
             (r - psi_dot) / tau, rel=1e-5, abs=1e-9
         )
         assert system.GetOutputPort("psi_dot_law").Eval(context)[0] == pytest.approx(r)
+
+
+@pytest.mark.parametrize("standup_state", [1, 2, 3, 4])
+def test_psi_advances_only_in_the_stand_ups_own_states(standup_state):
+    """The same helpful inputs: psi = t in state 1 (seated, or returning to the seat
+    after a hindering pull), the law's rate r in states 2-4."""
+    v = 1.6 * TANGENT
+    omega_f = TANGENT / np.linalg.norm(TANGENT)
+    r = (v @ TANGENT) / (TANGENT @ TANGENT + CFG.eps)
+    system, context = _simulate_advancement(CFG, v, omega_f, TANGENT, 1.0, standup_state)
+    expected = 1.0 if standup_state == 1 else r
+    assert system.GetOutputPort("psi_dot_law").Eval(context)[0] == pytest.approx(expected)
+    if standup_state == 1:
+        assert system.GetOutputPort("psi").Eval(context)[0] == pytest.approx(1.0, abs=1e-9)
 
 
 def test_graded_gate_weights_the_laws_excess_by_the_help():

@@ -6,14 +6,23 @@ must be a ScenarioError whose message is one line naming that key path.
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 import icub_models
 import pytest
+import yaml
 
-from drake_standup.config import Scenario, ScenarioError, load_scenario, parse_scenario
+from drake_standup.config import (
+    RULES,
+    Scenario,
+    ScenarioError,
+    apply_overrides,
+    load_scenario,
+    parse_scenario,
+)
 
 REPO = Path(__file__).resolve().parent.parent
 SEATED = REPO / "scenarios" / "seated.yaml"
@@ -166,3 +175,65 @@ def test_the_readme_scenario_example_parses():
     scenario = parse_scenario(example)
     assert scenario.standup.standing_com_height_m == 0.575
     assert scenario.human.reactive.guide == "path"
+
+
+def _every_key(scenario: Scenario) -> list[tuple[str, object]]:
+    """(key path, value) of every value of scenario, from its YAML dump."""
+    from pydrake.common.yaml import yaml_dump_typed
+
+    found = []
+
+    def walk(prefix: str, value) -> None:
+        found.append((prefix, value))
+        items = value.items() if isinstance(value, dict) else ()
+        items = enumerate(value) if isinstance(value, list) else items
+        for key, item in items:
+            walk(f"{prefix}[{key}]" if isinstance(key, int) else f"{prefix}.{key}", item)
+
+    for key, value in yaml.safe_load(yaml_dump_typed(scenario)).items():
+        walk(key, value)
+    return found
+
+
+def _full_scenario() -> Scenario:
+    """The assisted scenario with one of everything: a pull, a push, a torque limit."""
+    return apply_overrides(
+        load_scenario("assisted"),
+        [("perturbation.pushes", [{"body": "chest"}]), ("controller.torque_limit_Nm", 50.0)],
+    )
+
+
+def test_every_rule_names_a_key():
+    """Each pattern of RULES vs the key paths of a scenario that has every kind of entry:
+    a pattern that names nothing (a typo, a renamed field) checks nothing."""
+    keys = [key for key, _ in _every_key(_full_scenario())]
+    for _, patterns in RULES:
+        for pattern in patterns.split():
+            regex = re.escape(pattern).replace(r"\[\*\]", r"\[\d+\]").replace(r"\*", r"[^.\[]*")
+            assert any(re.fullmatch(regex, key) for key in keys), pattern
+
+
+# Values no rule bounds, and why: angles and names that only the model can check (the
+# joint limits clamp the posture targets; a name the model lacks is an error at build),
+# the chair file (checked to exist), lead_max_m (checked against lead_min_m).
+UNBOUNDED = (
+    r"robot\.model|chair\.file|initial\.joints_rad\..*|controller\.posture_state\d_rad\..*"
+    r"|controller\.seat_hinge_joints\[\d+\]|perturbation\.pushes\[\d+\]\.body"
+    r"|human\.reactive\.lead_max_m"
+)
+
+
+def test_every_number_and_name_is_checked_by_a_rule_or_named_unbounded():
+    """Every leaf of the scenario that is not true/false vs RULES: bounded by a rule (of
+    itself or of its list), or in UNBOUNDED; the controller's settings included."""
+    keys = _every_key(_full_scenario())
+    patterns = [
+        re.escape(p).replace(r"\[\*\]", r"\[\d+\]").replace(r"\*", r"[^.\[]*")
+        for _, text in RULES
+        for p in text.split()
+    ]
+    for key, value in keys:
+        if isinstance(value, dict | list | bool):
+            continue
+        covered = any(re.fullmatch(p, k) for p in patterns for k in (key, key.rsplit("[", 1)[0]))
+        assert covered or re.fullmatch(UNBOUNDED, key), key

@@ -16,6 +16,7 @@ from drake_standup.control.qp import ContactCommands, ContactMap, QpLayout, Task
 from drake_standup.control.references import TaskReferences, static_lean
 from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.controller import ControllerConfig, WholeBodyController
+from drake_standup.robot import EFFORT_LIMIT_NM
 from drake_standup.scene import add_scene, set_seated_state
 
 TARGET_RAD_PER_S2 = 2.0
@@ -104,7 +105,7 @@ def _qp(plant, specs, task_states, **bounds):
     return WholeBodyQp(
         contact_map,
         plant.MakeActuationMatrix(),
-        torque_limit_Nm=config.torque_limit_Nm,
+        torque_limit_Nm=EFFORT_LIMIT_NM,
         torque_weight=config.torque_weight,
         wrench_weight=config.wrench_weight,
         acceleration_weight=config.acceleration_weight,
@@ -223,11 +224,10 @@ def test_an_infeasible_program_falls_back_to_the_relaxed_one(seated):
     dynamics' base rows still exact and the torques within their limits."""
     plant, specs, terms, _ = seated
     nc = len(specs)
-    config = ControllerConfig()
     impossible = ContactCommands(np.full(nc, 1000.0), np.full(nc, 2000.0), {})
     solution = _qp(plant, specs, None).solve(terms, _references(2), impossible)
     assert solution.ok and solution.relaxed
-    assert np.abs(solution.tau).max() <= config.torque_limit_Nm + 1e-6
+    assert np.abs(solution.tau).max() <= EFFORT_LIMIT_NM + 1e-6
     # The floating base's rows of M vdot + h = J^T F hold (no actuation there).
     contact_map = ContactMap(specs, plant.num_velocities())
     generalized = contact_map(terms).T @ solution.F_C.reshape(-1)[contact_map.unknowns]

@@ -20,6 +20,7 @@ from drake_standup.config import Scenario
 from drake_standup.control.references import helpful_force
 from drake_standup.control.terms import RobotKinematics
 from drake_standup.controller import ControllerConfig, WholeBodyController
+from drake_standup.robot import EFFORT_LIMIT_NM
 from drake_standup.scene import add_scene, set_seated_state
 
 G = 9.81
@@ -148,7 +149,7 @@ def test_solution_satisfies_dynamics_and_contact_limits(scene, standup_state):
         rhs += jacobian("l_hand").T @ hands[:6] + jacobian("r_hand").T @ hands[6:]
         np.testing.assert_allclose(lhs, rhs, atol=1e-6 * max(1.0, np.abs(lhs).max()))
 
-        assert np.abs(solution.tau).max() <= config.torque_limit_Nm + 1e-6
+        assert np.abs(solution.tau).max() <= EFFORT_LIMIT_NM + 1e-6
         for frame_name, F_W in zip(solution.frames, solution.F_W, strict=True):
             R_WC = robot.frame(plant, frame_name).CalcPoseInWorld(plant_context).rotation()
             tau_C = R_WC.inverse() @ F_W[:3]
@@ -405,7 +406,7 @@ def test_an_infeasible_qp_falls_back_to_the_relaxed_program_and_counts(scene):
     within the limits; qp_ok stays 1, qp_relaxed counts the four ticks, no failure."""
     last, actuation, diagnostics = _infeasible_ticks(scene, break_fallback=False)
     assert not np.array_equal(actuation, last)
-    assert np.abs(actuation).max() <= ControllerConfig().torque_limit_Nm + 1e-6
+    assert np.abs(actuation).max() <= EFFORT_LIMIT_NM + 1e-6
     assert diagnostics["qp_ok"] == 1.0 and diagnostics["qp_failures"] == 0.0
     assert diagnostics["qp_relaxed"] == 4.0
 
@@ -508,3 +509,33 @@ def test_ports_and_config(scene):
         _controller(scene, qp_solver="cplex")
     with pytest.raises(ValueError, match="posture_state2_rad"):
         _controller(scene, posture_state2_rad={"no_such_joint": 0.0})
+
+
+@pytest.mark.parametrize("scale", [0.85, 1.15])
+def test_scaled_model_terms_are_drakes_with_scaled_masses(scene, scale):
+    """RobotKinematics.set_mass_scale: M, h and the CoM equal Drake's own for a plant
+    context whose every robot body's mass is scaled (CoM and unit inertia kept)."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    context = plant.CreateDefaultContext()
+    for index in plant.GetBodyIndices(instance):
+        body = plant.get_body(index)
+        body.SetMass(context, scale * body.default_mass())
+    kinematics = RobotKinematics(plant, robot, held_frames=[], other_frames=[])
+    nominal = kinematics.mass_kg
+    kinematics.set_mass_scale(scale)
+    assert kinematics.mass_kg == pytest.approx(plant.CalcTotalMass(context, [instance]))
+    assert kinematics.mass_kg == pytest.approx(scale * nominal)
+    rng = np.random.default_rng(5)
+    for _ in range(4):
+        x = _random_state(plant, instance, x0, rng)
+        plant.SetPositionsAndVelocities(context, instance, x)
+        terms = kinematics.calc(x, [])
+        np.testing.assert_allclose(terms.M, plant.CalcMassMatrix(context), atol=1e-10)
+        h = plant.CalcBiasTerm(context) - plant.CalcGravityGeneralizedForces(context)
+        h += _joint_damping(plant, instance) * x[plant.num_positions() :]
+        np.testing.assert_allclose(terms.h, h, atol=1e-9)
+        np.testing.assert_allclose(
+            terms.p_WCom, plant.CalcCenterOfMassPositionInWorld(context, [instance]), atol=1e-12
+        )

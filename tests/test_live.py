@@ -305,6 +305,22 @@ def test_a_live_run_goes_on_after_a_fall_and_reset_stands_the_robot_up_again():
 
 
 @pytest.mark.slow
+def test_a_fall_no_reset_undid_is_the_runs_failure_reason():
+    """The same toppling pull, nobody clicking Reset: the run goes on to its end and
+    metrics.json's failure_reason is the fall the console reported."""
+    scenario = _quick("time")
+    scenario.duration_s = 2.0
+    scenario.simulator.target_realtime_rate = 0.0
+    session = _Pulling(scenario, (-3.0, 0.0))
+    lines = []
+    session._report = lines.append
+    result = simulate(scenario, None, progress=False, live=session)
+    assert result.metrics["sim_time_s"] == pytest.approx(2.0)
+    assert result.metrics["failure_reason"].startswith("fall: root_link height")
+    assert lines == [f"{result.metrics['failure_reason']}; Reset puts the robot back on the chair"]
+
+
+@pytest.mark.slow
 def test_run_diagram_live_prints_one_address_and_writes_the_outputs(tmp_path):
     """The command as a user types it: one line with the page's address (Drake's own
     log line about it silenced), paced at real time, exit 0, the normal outputs."""

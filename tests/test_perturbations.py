@@ -34,8 +34,9 @@ from drake_standup.perturbations import (
     apply_model_errors,
     scale_friction,
 )
+from drake_standup.resources import model_file
 from drake_standup.robot import ContactModel, add_icub
-from drake_standup.scene import MODELS_DIR, set_seated_state
+from drake_standup.scene import set_seated_state
 from drake_standup.simulate import simulate
 
 PUSHES = [
@@ -69,6 +70,7 @@ DEFAULT_SYSTEMS = {
     "com_reference",
     "contact_forces",
     "seat_pad_forces",
+    "pads_vertical_force",
     "controller",
     "human",
     "plant",
@@ -516,7 +518,7 @@ def _sliding_speed(scale: float, push_N: float, t_end: float = 0.3) -> float:
         for i, (x, y) in enumerate([(0.05, 0.05), (0.05, -0.05), (-0.05, 0.05), (-0.05, -0.05)])
     )
     parser = Parser(plant)
-    (floor,) = parser.AddModels(str(MODELS_DIR / "floor.sdf"))
+    (floor,) = parser.AddModels(str(model_file("floor.sdf")))
     parser.AddModelsFromString(BLOCK_SDF.format(spheres=spheres), "sdf")
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("floor", floor))
     plant.Finalize()

@@ -120,11 +120,17 @@ def test_a_hindering_pull_waits_seated_and_the_robot_stands_up_once_it_stops():
     assert m["com_final_m"][2] == pytest.approx(m["standing_com_height_m"], abs=0.01)
 
 
-@pytest.mark.parametrize("start_s", [5.2, 8.0])
-def test_a_hindering_pull_on_the_rising_or_standing_robot_does_not_topple_it(start_s):
-    """Issue 13: 15 N backwards on each hand for 4 s, from inside state 4 (5.2 s) or on the
-    standing robot (8.0 s): it leans into the pull within its feet and stays standing
-    when the pull stops (before the lean was bounded by the feet it fell then)."""
+@pytest.mark.parametrize(
+    "start_s",
+    [1.0, 3.5, 4.6, 5.2, 8.0],
+    ids=["seated", "in_state_2", "in_state_3", "in_state_4", "standing"],
+)
+def test_a_hindering_pull_in_any_state_does_not_topple_it(start_s):
+    """Issue 13: 15 N backwards on each hand for 4 s, started before the stand-up (1.0 s),
+    inside state 2 (3.5 s: it sits back and waits), state 3 (4.6 s: it holds there),
+    state 4 (5.2 s) or on the standing robot (8.0 s: it leans into the pull within its
+    feet). No fall, psi = t throughout, and it ends standing erect (before the lean was
+    bounded by the feet it fell when the pull stopped)."""
     from drake_standup.config import Pull
 
     scenario = load_scenario(SCENARIO_DIR / "unassisted.yaml")
@@ -132,9 +138,27 @@ def test_a_hindering_pull_on_the_rising_or_standing_robot_does_not_topple_it(sta
         Pull(hand=hand, start_s=start_s, duration_s=4.0, ramp_s=0.3, force_N=[-15.0, 0.0, 0.0])
         for hand in ("left", "right")
     ]
+    scenario.duration_s = max(scenario.duration_s, start_s + 4.0 + 5.0)
     m = simulate(scenario, None, record=False, progress=False).metrics
     assert m["success"], m["failure_reason"]
+    assert m["qp_failures"] == 0
     assert m["psi_dot_max"] == 1.0
+    assert m["com_final_m"][2] == pytest.approx(m["standing_com_height_m"], abs=0.01)
+
+
+@pytest.mark.parametrize("mass_scale", [0.85, 1.15])
+def test_a_robot_lighter_or_heavier_than_its_model_weighs_itself_and_stands_up(mass_scale):
+    """Issue 13: the simulated robot 15 % lighter or heavier than the controller's model,
+    under the default pull. Seated, the controller weighs it on its pads (m g = the pads'
+    and hands' vertical forces): the estimate is the simulated mass within 1 %, and the
+    robot stands up erect and stays standing."""
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
+    scenario.duration_s = 8.0
+    scenario.perturbation.mass_scale = mass_scale
+    m = simulate(scenario, None, record=False, progress=False).metrics
+    assert m["success"], m["failure_reason"]
+    assert m["qp_failures"] == 0
+    assert m["model_mass_kg"] == pytest.approx(m["simulated_mass_kg"], rel=0.01)
     assert m["com_final_m"][2] == pytest.approx(m["standing_com_height_m"], abs=0.01)
 
 

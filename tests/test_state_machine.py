@@ -305,28 +305,67 @@ def test_a_backward_pull_keeps_the_robot_seated():
     assert _next(mode, _m(3.5, hands=weak), cfg).state == 2
 
 
-def test_a_backward_pull_in_state_2_sits_back_without_a_reference_jump():
-    """Back to state 1, the reference held where the state-2 segment had brought it
-    (the path evaluated independently here), the balancing time running again."""
-    mode = _in_state(2, 3.0)
-    psi = 3.6
-    m = _m(3.6, psi=psi, hands=(-10.0, -10.0))
-    new = _next(mode, m)
-    assert new.state == 1 and new.entry_times_s[0] == 3.6
-    assert math.isnan(new.entry_times_s[1])
+@pytest.mark.parametrize("state", [2, 3])
+def test_a_backward_pull_with_the_thighs_on_the_chair_sits_back_without_a_jump(state):
+    """In state 2, or in state 3 while the thighs still carry most of their load: back to
+    state 1, the
+    reference starting where its segment had brought it (the path evaluated
+    independently here) and returning to the seated CoM, the balancing time running
+    again; state 2 waits for the return and then starts from the seated CoM, so that it
+    ends where the first attempt's would have."""
+    cfg = dataclasses.replace(CFG, trigger="time")
+    mode = _in_state(state, 3.0, cfg)
+    assert mode.x_seated_m == tuple(COM0)
+    # A quarter into the thighs' release: they carry 84 % of their load (smoothstep).
+    t = psi = 3.0 + 0.25 * min(cfg.seat_release_s, mode.segment_psi)
+    new = _next(mode, _m(t, psi=psi, hands=(-10.0, -10.0)), cfg)
+    assert new.state == 1 and new.entry_times_s[0] == t
+    assert all(math.isnan(e) for e in new.entry_times_s[1:])
     tau = (psi - mode.psi_entry) / mode.segment_psi
     s = 10 * tau**3 - 15 * tau**4 + 6 * tau**5
     expected = np.array(mode.x_start_m) + s * np.array(mode.delta_m)
     np.testing.assert_allclose(new.x_start_m, expected, atol=1e-12)
-    assert new.delta_m == (0.0, 0.0, 0.0)
+    np.testing.assert_allclose(new.segment_end(), COM0, atol=1e-12)
+    # The balancing time has run but the return has not: still seated.
+    late = t + cfg.balance_time_s + 0.01
+    calm = (0.0, 0.0)
+    assert _next(new, _m(late, psi=t + 0.5 * new.segment_psi, hands=calm), cfg).state == 1
+    again = _next(new, _m(late, psi=t + new.segment_psi + 0.01, hands=calm), cfg)
+    assert again.state == 2
+    np.testing.assert_allclose(again.x_start_m, COM0, atol=1e-12)
 
 
-def test_state_3_holds_while_hindered_and_goes_on_when_the_pull_stops():
-    mode = _in_state(3, 5.0)
-    t_ok = 5.0 + max(CFG.min_time_state3_s, CFG.seat_release_s)
+@pytest.mark.parametrize("into_release", [0.6, 1.01])
+def test_state_3_holds_once_the_thighs_are_mostly_off_the_chair(into_release):
+    """Past the middle of the thighs' release (they carry 35 % of their load at 0.6 of
+    it, smoothstep) a backward pull no longer sits the robot back: state 3 holds."""
+    cfg = dataclasses.replace(CFG, trigger="time")
+    mode = _in_state(3, 5.0, cfg)
+    t = 5.0 + into_release * cfg.seat_release_s
     feet = (500.0, 500.0)
-    assert _next(mode, _m(t_ok, feet=feet, hands=(-10.0, -10.0))).state == 3
-    assert _next(mode, _m(t_ok, feet=feet, hands=(0.0, 0.0))).state == 4
+    held = _next(mode, _m(t, feet=feet, hands=(-10.0, -10.0)), cfg)
+    assert held.state == 3 and held.x_start_m == mode.x_start_m
+    assert _next(held, _m(t + 0.1, feet=feet, hands=(-10.0, -10.0)), cfg).state == 3
+
+
+def test_the_stand_up_resumes_only_a_while_after_the_pull_stops():
+    """Seated, balanced long enough, a hindering pull felt until t = 5 s: the stand-up
+    starts resume_after_s later, not before."""
+    cfg = dataclasses.replace(CFG, trigger="time")
+    mode = dataclasses.replace(initial_mode(COM0), hindered_until_s=5.0)
+    early = 5.0 + 0.9 * cfg.resume_after_s
+    assert _next(mode, _m(early, psi=early, hands=(0.0, 0.0)), cfg).state == 1
+    late = 5.0 + cfg.resume_after_s + 0.01
+    assert _next(mode, _m(late, psi=late, hands=(0.0, 0.0)), cfg).state == 2
+
+
+def test_state_3_goes_on_once_the_pull_has_stopped_for_a_while():
+    mode = _in_state(3, 5.0)
+    t_ok = 5.0 + max(CFG.min_time_state3_s, CFG.seat_release_s) + 0.01
+    feet = (500.0, 500.0)
+    mode = dataclasses.replace(mode, hindered_until_s=t_ok)
+    assert _next(mode, _m(t_ok + 0.9 * CFG.resume_after_s, feet=feet, hands=(0.0, 0.0))).state == 3
+    assert _next(mode, _m(t_ok + CFG.resume_after_s + 0.01, feet=feet, hands=(0, 0))).state == 4
 
 
 def test_time_held_back_accumulates_while_hindered():

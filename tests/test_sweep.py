@@ -13,17 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drake_standup.config import REPO_ROOT, load_scenario, set_key_path
-from drake_standup.sweep import (
-    SweepError,
-    expand,
-    load_sweep,
-    main,
-    read_table,
-    run_one,
-    run_sweep,
-    simulation_rows,
-)
+from drake_standup.config import SCENARIO_DIR, apply_overrides, load_scenario
+from drake_standup.sweep import main, run_one, run_sweep
+from drake_standup.sweep_file import SweepError, expand, load_sweep
+from drake_standup.sweep_table import read_table, simulation_rows
 
 
 def _write(tmp_path: Path, text: str, name: str = "sweep.yaml") -> Path:
@@ -52,7 +45,7 @@ def test_grid_expands_every_combination_onto_every_named_key(tmp_path):
     assert len(runs) == 3 * 2
     combos = [(r.params["pull"], r.params["advancement.psi_dot_upper"]) for r in runs]
     assert combos == [(f, u) for f in (0, 10, 20) for u in (1.5, 2.5)]
-    base = load_scenario(REPO_ROOT / "scenarios/assisted.yaml")
+    base = load_scenario(SCENARIO_DIR / "assisted.yaml")
     for run in runs:
         paths = dict(run.overrides)
         # [*] named both pulls; both components x and z are set.
@@ -62,9 +55,7 @@ def test_grid_expands_every_combination_onto_every_named_key(tmp_path):
         assert paths["advancement.psi_dot_upper"] == run.params["advancement.psi_dot_upper"]
         assert paths["duration_s"] == 0.3
         # Applied to the base scenario, the overrides give exactly those values.
-        scenario = load_scenario(REPO_ROOT / "scenarios/assisted.yaml")
-        for path, value in run.overrides:
-            set_key_path(scenario, path, value)
+        scenario = apply_overrides(base, run.overrides)
         assert scenario.human.pulls[1].force_N == [run.params["pull"], 0.0, run.params["pull"]]
         assert scenario.human.pulls[0].hand == base.human.pulls[0].hand
     assert len({r.run_id for r in runs}) == len(runs)
@@ -129,7 +120,7 @@ def test_seeded_random_draws_are_reproducible_and_per_run(tmp_path):
         ("base: scenarios/assisted.yaml\ngrids: {}\n", "sweep.grids: unknown key"),
         (
             "base: scenarios/assisted.yaml\ngrid: {advancement.speed: [1]}\n",
-            "advancement has no key 'speed'",
+            "advancement.speed: unknown key; accepted: enabled, law",
         ),
         (
             "base: scenarios/assisted.yaml\ngrid: {'human.pulls[4].force_N[0]': [1]}\n",
@@ -332,7 +323,7 @@ def test_a_rate_figure_draws_its_reference_lines(tmp_path):
     """The lines of a figure end up on the axes, at their x (matplotlib's own record)."""
     from unittest import mock
 
-    from drake_standup.sweep import Figure, draw_figure
+    from drake_standup.sweep_figures import Figure, draw_figure
 
     records = [
         {

@@ -109,7 +109,9 @@ class RobotKinematics:
                 self._on_base[name] = X_BF @ p_FP, X_BF.rotation().matrix().T
         self._requests: dict[tuple[str, ...], tuple[list, int]] = {}
         self._gravity_W = plant.gravity_field().gravity_vector()
-        self.mass_kg = plant.CalcTotalMass(self._context, [instance])
+        self.mass_kg = self.nominal_mass_kg = plant.CalcTotalMass(self._context, [instance])
+        self._bodies = [plant.get_body(i) for i in plant.GetBodyIndices(instance)]
+        self.mass_scale = 1.0
         self.nq, self.nv = plant.num_positions(), plant.num_velocities()
         # M[0:3, 3:6] = m [p_BoCom]x: its entries (2, 1), (0, 2), (1, 0) in M, flat.
         self._com_entries = np.array([2 * self.nv + 4, 5, self.nv + 3])
@@ -122,6 +124,16 @@ class RobotKinematics:
             joint = plant.get_joint(index)
             start, count = joint.velocity_start(), joint.num_velocities()
             self._damping[start : start + count] = joint.default_damping_vector()
+
+    def set_mass_scale(self, scale: float) -> None:
+        """Every body's mass scaled by scale from its default (CoM and unit inertia kept,
+        so the rotational inertia scales too): the model the terms are computed with."""
+        if scale == self.mass_scale:
+            return
+        for body in self._bodies:
+            body.SetMass(self._context, scale * body.default_mass())
+        self.mass_scale = scale
+        self.mass_kg = scale * self.nominal_mass_kg
 
     def _request(self, frame_names: list[str]) -> tuple[list, int]:
         """Per frame asked for: (frame, hold point or None, held, (P in B, R_FB) if on

@@ -1,0 +1,364 @@
+"""The sweep file and its expansion into runs.
+
+A sweep file names a base scenario, the parameters to vary by their scenario key paths (a
+grid, and seeded random draws), fixed overrides and perturbations (pushes on the torso,
+mass and friction errors, noise on the measured hand wrench); see sweeps/*.yaml and the
+README. Every run is expanded here, so what a run simulates depends only on the sweep file
+and its index, never on which worker ran it or in what order. A run is the base scenario's
+text and its overrides [(key path, value)], applied through config.apply_overrides: the
+same loader, and the same checks, as a scenario file and `--set`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from drake_standup.config import (
+    ScenarioError,
+    apply_overrides,
+    expand_key_path,
+    parse_scenario,
+)
+from drake_standup.resources import find, shipped
+
+
+class SweepError(ValueError):
+    """A sweep file that cannot run; the message is one line naming the key."""
+
+
+DISTRIBUTIONS = ("uniform", "normal", "choice")
+
+
+@dataclass
+class Parameter:
+    """One column of the table: its name, the key paths it sets, its values."""
+
+    name: str
+    paths: list[str]
+    values: list | None = None  # grid
+    draw: dict | None = None  # random: {'uniform': [a, b]} | {'normal': [m, s]} | {'choice': [...]}
+
+
+@dataclass
+class Figure:
+    kind: str = "line"  # 'line': mean of y per x (per group); 'rate': mean of y per x bin
+    x: str = ""
+    y: str = ""
+    group: str | None = None
+    bins: int = 6
+    range: list[float] | None = None  # rate: the bins' span (default: the data's)
+    title: str | None = None
+    # Vertical reference lines: [{x: value, label: text}], e.g. a bound from theory.
+    lines: list[dict] = field(default_factory=list)
+
+
+@dataclass
+class SweepSpec:
+    name: str
+    base_path: Path
+    base_text: str
+    seed: int
+    samples: int
+    overrides: dict
+    grid: list[Parameter]
+    random: list[Parameter]
+    perturbations: dict
+    figures: list[Figure]
+
+
+@dataclass
+class RunSpec:
+    index: int
+    run_id: str
+    params: dict  # column -> value (grid, random and perturbation draws)
+    overrides: list  # [(concrete key path, value)], in order
+
+
+TOP_KEYS = ("name", "base", "seed", "samples", "overrides", "grid", "random")
+TOP_KEYS += ("perturbations", "figures")
+PERTURBATION_KEYS = ("push", "mass_scale", "friction_scale", "hand_wrench_noise_N")
+PUSH_KEYS = ("body", "start_s", "duration_s", "magnitude_N", "azimuth_deg", "elevation_deg")
+# What a push key left out of a sweep file means (config.Push's defaults).
+PUSH_DEFAULTS = {"start_s": 5.0, "duration_s": 0.2, "magnitude_N": 0.0}
+PUSH_DEFAULTS.update(azimuth_deg=0.0, elevation_deg=0.0)
+
+
+def load_sweep(path: str | Path) -> SweepSpec:
+    """Reads and checks a sweep file (a path, or the name of a shipped sweep); raises
+    SweepError (one line)."""
+    found = find("sweeps", path)
+    if found is None:
+        names = ", ".join(shipped("sweeps"))
+        raise SweepError(
+            f"sweep: file '{path}' not found; accepted: a YAML file or a shipped sweep: {names}"
+        )
+    try:
+        raw = yaml.safe_load(found.read_text()) or {}
+    except yaml.YAMLError as err:
+        raise SweepError(f"sweep {found}: not valid YAML ({' '.join(str(err).split())})") from None
+    if not isinstance(raw, dict):
+        raise SweepError(f"sweep {found}: a mapping of {', '.join(TOP_KEYS)} expected")
+    _known("sweep", raw, TOP_KEYS)
+    if "base" not in raw:
+        raise SweepError("base: missing; accepted: the path of a scenario YAML file")
+    base_path = find("scenarios", raw["base"], found.parent)
+    if base_path is None:
+        raise SweepError(
+            f"base: '{raw['base']}' not found; accepted: a scenario YAML path (relative to the "
+            "current directory or the sweep file), or a shipped scenario's name"
+        )
+    overrides = raw.get("overrides") or {}
+    if not isinstance(overrides, dict):
+        raise SweepError("overrides: accepted: a mapping of key path -> value")
+    perturbations = raw.get("perturbations") or {}
+    _check_perturbations(perturbations)
+    spec = SweepSpec(
+        name=str(raw.get("name", found.stem)),
+        base_path=base_path,
+        base_text=base_path.read_text(),
+        seed=_integer("seed", raw.get("seed", 0), 0),
+        samples=_integer("samples", raw.get("samples", 1), 1),
+        overrides=overrides,
+        grid=[_parameter(f"grid[{i}]", p, "values") for i, p in enumerate(_entries(raw, "grid"))],
+        random=[
+            _parameter(f"random[{i}]", p, "draw") for i, p in enumerate(_entries(raw, "random"))
+        ],
+        perturbations=perturbations,
+        figures=[_figure(f"figures[{i}]", f) for i, f in enumerate(raw.get("figures") or [])],
+    )
+    names = [p.name for p in spec.grid + spec.random]
+    if len(set(names)) != len(names):
+        raise SweepError(f"grid/random: a column name is used twice in {names}")
+    expand(spec)  # every key path and value checked against the base scenario now
+    return spec
+
+
+def _known(where: str, mapping: dict, accepted: tuple[str, ...]) -> None:
+    for key in mapping:
+        if key not in accepted:
+            raise SweepError(f"{where}.{key}: unknown key; accepted: {', '.join(accepted)}")
+
+
+def _integer(where: str, value, low: int) -> int:
+    if not isinstance(value, int) or isinstance(value, bool) or value < low:
+        raise SweepError(f"{where}: {value!r}; accepted: an integer >= {low}")
+    return value
+
+
+def _number(value) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def _check_perturbations(perturbations) -> None:
+    if not isinstance(perturbations, dict):
+        raise SweepError(f"perturbations: accepted: a mapping of {', '.join(PERTURBATION_KEYS)}")
+    _known("perturbations", perturbations, PERTURBATION_KEYS)
+    if "push" in perturbations:
+        push = perturbations["push"]
+        if not isinstance(push, dict):
+            raise SweepError(f"perturbations.push: accepted: a mapping of {', '.join(PUSH_KEYS)}")
+        _known("perturbations.push", push, PUSH_KEYS)
+        for key in PUSH_KEYS[1:]:
+            _check_draw(f"perturbations.push.{key}", push.get(key, 0.0))
+        if not isinstance(push.get("body", "chest"), str):
+            raise SweepError("perturbations.push.body: accepted: the name of a robot body")
+    for key in PERTURBATION_KEYS[1:]:
+        if key in perturbations:
+            _check_draw(f"perturbations.{key}", perturbations[key])
+
+
+def _entries(raw: dict, key: str) -> list[dict]:
+    """grid/random as a list of entries; a mapping {path: values} is a shorthand."""
+    value = raw.get(key) or []
+    if isinstance(value, dict):
+        kind = "values" if key == "grid" else "draw"
+        return [{"path": path, kind: v} for path, v in value.items()]
+    if not isinstance(value, list) or not all(isinstance(e, dict) for e in value):
+        raise SweepError(f"{key}: accepted: a list of {{name, path(s), values}} or path: values")
+    return value
+
+
+def _parameter(where: str, entry: dict, kind: str) -> Parameter:
+    _known(where, entry, ("name", "path", "paths", kind))
+    paths = entry.get("paths", entry.get("path"))
+    paths = [paths] if isinstance(paths, str) else paths
+    if not paths or not all(isinstance(p, str) for p in paths):
+        raise SweepError(f"{where}.path: missing; accepted: a scenario key path or a list of them")
+    name = entry.get("name", paths[0])
+    if kind == "values":
+        values = entry.get("values")
+        if not isinstance(values, list) or not values:
+            raise SweepError(f"{where}.values: {values!r}; accepted: a non-empty list")
+        return Parameter(name, paths, values=values)
+    _check_draw(f"{where}.draw", entry.get("draw"), constant_ok=False)
+    return Parameter(name, paths, draw=entry["draw"])
+
+
+def _check_draw(where: str, draw, constant_ok: bool = True) -> None:
+    if constant_ok and isinstance(draw, int | float | str) and not isinstance(draw, bool):
+        return
+    ok = isinstance(draw, dict) and len(draw) == 1 and next(iter(draw)) in DISTRIBUTIONS
+    if ok:
+        ((kind, args),) = draw.items()
+        ok = isinstance(args, list) and len(args) > 0
+        if kind != "choice":
+            ok = ok and len(args) == 2 and all(_number(a) for a in args)
+            ok = ok and (args[0] <= args[1] if kind == "uniform" else args[1] >= 0)
+    if not ok:
+        accepted = "a number, " if constant_ok else ""
+        raise SweepError(
+            f"{where}: {draw!r}; accepted: {accepted}{{uniform: [low, high]}}, "
+            "{normal: [mean, std]} or {choice: [a, b, ...]}"
+        )
+
+
+def _figure(where: str, entry) -> Figure:
+    if not isinstance(entry, dict):
+        raise SweepError(f"{where}: accepted: a mapping of kind, x, y, group, bins, title")
+    _known(where, entry, tuple(Figure.__dataclass_fields__))
+    figure = Figure(**entry)
+    lines = figure.lines
+    if not isinstance(lines, list) or not all(
+        isinstance(line, dict)
+        and set(line) == {"x", "label"}
+        and _number(line["x"])
+        and isinstance(line["label"], str)
+        for line in lines
+    ):
+        raise SweepError(
+            f"{where}.lines: {lines!r}; accepted: a list of {{x: number, label: text}}"
+        )
+    span = figure.range
+    if span is not None and not (
+        isinstance(span, list) and len(span) == 2 and all(map(_number, span)) and span[0] < span[1]
+    ):
+        raise SweepError(f"{where}.range: {span!r}; accepted: [low, high] with low < high")
+    _integer(f"{where}.bins", figure.bins, 1)
+    if figure.kind not in ("line", "rate"):
+        raise SweepError(f"{where}.kind: {figure.kind!r}; accepted: line | rate")
+    for key in ("x", "y"):
+        if not isinstance(entry.get(key), str):
+            raise SweepError(f"{where}.{key}: missing; accepted: a column of the results table")
+    return figure
+
+
+# --- Expansion: the sweep file -> one RunSpec per run -----------------------------------
+
+
+def _draw(rng: np.random.Generator, draw):
+    """One value of a distribution (a constant is itself; one rng call per draw
+    either way, so the stream does not shift when a constant becomes random)."""
+    u = rng.random()
+    if not isinstance(draw, dict):
+        return draw
+    ((kind, args),) = draw.items()
+    if kind == "uniform":
+        return float(args[0] + u * (args[1] - args[0]))
+    if kind == "normal":
+        # Inverse-CDF free: a second variate for the Gaussian.
+        return float(args[0] + args[1] * rng.standard_normal())
+    return args[min(int(u * len(args)), len(args) - 1)]
+
+
+def _run_id(base_text: str, overrides: list) -> str:
+    """Names a run by what it simulates: base scenario and overrides."""
+    payload = json.dumps({"base": base_text, "overrides": overrides}, sort_keys=True)
+    return hashlib.sha1(payload.encode()).hexdigest()[:12]
+
+
+def expand(spec: SweepSpec) -> list[RunSpec]:
+    """Grid x samples runs; run k's draws come from the generator seeded by
+    (seed, k), so a run's parameters don't depend on the others. Checks every
+    key path and value against the base scenario (raises SweepError)."""
+    try:
+        base = parse_scenario(spec.base_text, str(spec.base_path))
+    except ScenarioError as err:
+        raise SweepError(f"base: {err}") from None
+    fixed = []
+    for path, value in spec.overrides.items():
+        fixed += [(p, value) for p in _expand_path(base, path, f"overrides.{path}")]
+    base = _apply(base, fixed, "overrides")
+    grid_paths = {
+        param.name: [p for path in param.paths for p in _expand_path(base, path, param.name)]
+        for param in spec.grid + spec.random
+    }
+    combos = [{}]
+    for param in spec.grid:
+        combos = [{**c, param.name: v} for c in combos for v in param.values]
+    runs = []
+    for combo in combos:
+        for _ in range(spec.samples):
+            index = len(runs)
+            rng = np.random.default_rng([spec.seed, index])
+            params = dict(combo)
+            for param in spec.random:
+                params[param.name] = _draw(rng, param.draw)
+            overrides = []
+            for param in spec.grid + spec.random:
+                overrides += [(p, params[param.name]) for p in grid_paths[param.name]]
+            overrides += _perturbations(rng, spec.perturbations, params)
+            _apply(base, overrides, f"run {index} ({params})")
+            runs.append(
+                RunSpec(
+                    index, _run_id(spec.base_text, fixed + overrides), params, fixed + overrides
+                )
+            )
+    return runs
+
+
+def _perturbations(rng: np.random.Generator, pert: dict, params: dict) -> list:
+    """One run's draws of the perturbations: overrides, and their columns in params."""
+    overrides = []
+    if "push" in pert:
+        push = pert["push"]
+        start, duration, magnitude, azimuth, elevation = (
+            _draw(rng, push.get(k, PUSH_DEFAULTS[k])) for k in PUSH_KEYS[1:]
+        )
+        az, el = math.radians(azimuth), math.radians(elevation)
+        force = [
+            magnitude * math.cos(el) * math.cos(az),
+            magnitude * math.cos(el) * math.sin(az),
+            magnitude * math.sin(el),
+        ]
+        params.update(
+            push_start_s=start,
+            push_duration_s=duration,
+            push_magnitude_N=magnitude,
+            push_impulse_Ns=magnitude * duration,
+            push_azimuth_deg=azimuth,
+            push_elevation_deg=elevation,
+        )
+        body = push.get("body", "chest")
+        pushed = {"body": body, "start_s": start, "duration_s": duration, "force_N": force}
+        overrides.append(("perturbation.pushes", [] if magnitude == 0 else [pushed]))
+    for key in PERTURBATION_KEYS[1:]:
+        if key in pert:
+            params[key] = _draw(rng, pert[key])
+            overrides.append((f"perturbation.{key}", params[key]))
+    if "hand_wrench_noise_N" in pert:
+        overrides.append(("perturbation.noise_seed", int(rng.integers(0, 2**31 - 1))))
+    return overrides
+
+
+def _expand_path(base, path: str, where: str) -> list[str]:
+    try:
+        paths = expand_key_path(base, path)
+    except ScenarioError as err:
+        raise SweepError(f"{where}: {err}") from None
+    if not paths:
+        raise SweepError(f"{where}: key path '{path}' names no key of the base scenario")
+    return paths
+
+
+def _apply(scenario, overrides: list, where: str):
+    try:
+        return apply_overrides(scenario, overrides)
+    except ScenarioError as err:
+        raise SweepError(f"{where}: {err}") from None
