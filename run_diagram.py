@@ -2,7 +2,7 @@
 """Simulate the iCub stand-up scenario and write recording, metrics and diagram.
 
 python run_diagram.py [--scenario PATH|NAME] [--set KEY.PATH=VALUE] [--out DIR] [--duration S]
-                      [--no-recording]
+                      [--no-recording] [--live]
 
 The same as `drake-standup run` (drake_standup/cli.py).
 """

@@ -94,6 +94,12 @@ def run_parser(prog: str) -> OneLineErrorParser:
     parser.add_argument(
         "--no-recording", action="store_true", help="skip Meshcat and recording.html (faster)"
     )
+    parser.add_argument(
+        "--live",
+        action="store_true",
+        help="be the helper: paced at real time, pull the hands from the Meshcat page "
+        "(drake_standup/live.py); without --duration until Stop or Ctrl-C (at most 300 s)",
+    )
     return parser
 
 
@@ -116,6 +122,9 @@ def parse_set(text: str) -> tuple[str, object]:
 
 def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> int:
     args = run_parser(prog).parse_args(argv)
+    if args.live and args.no_recording:
+        print("error: --no-recording: not with --live (the live page is Meshcat)", file=sys.stderr)
+        return 2
 
     from drake_standup.config import ScenarioError, load_scenario
 
@@ -130,7 +139,12 @@ def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> 
     from drake_standup.simulate import simulate
 
     try:
-        result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
+        if args.live:
+            from drake_standup.live import run_live
+
+            result = run_live(scenario, args.out, args.duration)
+        else:
+            result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
     except ScenarioError as err:  # what only the built model can check (e.g. a body's name)
         print(f"error: {err}", file=sys.stderr)
         return 2

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,7 @@ from drake_standup.robot import ActuatedJoints, actuated_joints
 from drake_standup.scene import Scene, add_scene, set_seated_state
 from drake_standup.sensing import RobotSensing, heel_points
 from drake_standup.state_machine import StandupStateMachine
+from drake_standup.visuals import StandupVisuals
 
 
 @dataclass
@@ -53,13 +55,19 @@ CONTROLLERS = ("whole_body", "seat_hold")
 
 
 def build_diagram(
-    scenario: Scenario, meshcat: Meshcat | None = None, controller: str = "whole_body"
+    scenario: Scenario,
+    meshcat: Meshcat | None = None,
+    controller: str = "whole_body",
+    make_human: Callable | None = None,
 ) -> StandupDiagram:
     """The stand-up diagram: plant, human, advancement, reference, state machine,
     the controller, loggers and (optionally) Meshcat.
 
     controller: 'whole_body' (the momentum-based controller) or 'seat_hold'
     (Drake's joint PD holding the seated pose; the plant-only benchmark).
+    make_human(plant, robot, scenario.human): another human with the ports of
+    HumanWrenchSource (live.py's helper at the Meshcat page); an output port
+    stand_up, if it has one, goes to the state machine.
     """
     if controller not in CONTROLLERS:
         raise ValueError(f"controller: '{controller}'; accepted: {', '.join(CONTROLLERS)}")
@@ -87,7 +95,8 @@ def build_diagram(
     builder.Connect(plant.get_contact_results_output_port(), reporter.get_input_port())
 
     robot = scene.robot
-    human = builder.AddNamedSystem("human", HumanWrenchSource(plant, robot, scenario.human))
+    make_human = make_human or HumanWrenchSource
+    human = builder.AddNamedSystem("human", make_human(plant, robot, scenario.human))
     sensing = builder.AddNamedSystem("sensing", RobotSensing(plant, robot, heel_points(robot)))
     advancement = builder.AddNamedSystem("advancement", TrajectoryAdvancement(scenario.advancement))
     reference = builder.AddNamedSystem("com_reference", CoMReferenceGenerator())
@@ -121,6 +130,8 @@ def build_diagram(
     builder.Connect(sensing.GetOutputPort("heel_x_W"), state_machine.GetInputPort("heel_x_W"))
     builder.Connect(reporter.get_output_port(), state_machine.GetInputPort("pad_forces_W"))
     builder.Connect(hand_wrenches, state_machine.GetInputPort("hand_wrenches_W"))
+    if human.HasOutputPort("stand_up"):
+        builder.Connect(human.GetOutputPort("stand_up"), state_machine.GetInputPort("stand_up"))
 
     controller_system = None
     if controller == "whole_body":
@@ -211,6 +222,7 @@ def build_diagram(
                     newtons_per_meter=400.0,
                 ),
             )
+        _add_visuals(builder, scene, scenario, meshcat, human, sensing, reference, advancement)
 
     diagram = builder.Build()
     diagram.set_name("standup")
@@ -225,6 +237,34 @@ def build_diagram(
         logs,
         visualizer,
     )
+
+
+def _add_visuals(builder, scene, scenario, meshcat, human, sensing, reference, advancement):
+    """The pull's arrows, the CoM and its reference, the state and psi (visuals.py), at
+    the recording's rate."""
+    visuals = builder.AddNamedSystem(
+        "visuals",
+        StandupVisuals(
+            scene.plant,
+            scene.robot,
+            meshcat,
+            on_step_grid(scenario.visualization.publish_period_s, scenario.plant.time_step),
+            scenario.advancement.psi_dot_upper,
+        ),
+    )
+    state_machine = builder.GetSubsystemByName("state_machine")
+    sources = {
+        "robot_state": scene.plant.get_state_output_port(scene.robot.model_instance),
+        "hand_wrenches_W": human.GetOutputPort("hand_wrenches_W"),
+        "com_W": sensing.GetOutputPort("com_W"),
+        "x_d_W": reference.GetOutputPort("x_d_W"),
+        "standup_state": state_machine.GetOutputPort("standup_state"),
+        "psi": advancement.GetOutputPort("psi"),
+        "psi_dot": advancement.GetOutputPort("psi_dot"),
+        "entry_times_s": state_machine.GetOutputPort("entry_times_s"),
+    }
+    for name, port in sources.items():
+        builder.Connect(port, visuals.GetInputPort(name))
 
 
 def _seat_pads(robot) -> list[str]:

@@ -16,6 +16,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
@@ -30,6 +31,9 @@ from drake_standup.diagram import StandupDiagram, build_diagram
 from drake_standup.perturbations import apply_model_errors
 from drake_standup.progress import ProgressBar
 from drake_standup.scene import erect_com_height_m, set_seated_state
+
+if TYPE_CHECKING:
+    from drake_standup.live import LiveSession
 
 
 @dataclass
@@ -76,6 +80,7 @@ def simulate(
     baseline: bool = False,
     controller: str = "whole_body",
     chunk_s: float = 0.05,
+    live: LiveSession | None = None,
 ) -> RunResult:
     """Simulates scenario; writes recording, metrics, figures and diagram into out_dir.
 
@@ -84,6 +89,7 @@ def simulate(
     standup_time_s_without_advancement. Where nothing could advance psi (no
     human, or advancement already off) the run is its own baseline.
     controller: 'whole_body', or 'seat_hold' (the plant-only benchmark).
+    live: a live.LiveSession (its Meshcat, its human, called after each chunk).
     """
     pending = None
     if baseline and scenario.advancement.enabled and _human_acts(scenario):
@@ -100,6 +106,7 @@ def simulate(
             label="simulating",
             baseline=pending,
             controller=controller,
+            live=live,
         )
     except BaseException:
         if pending is not None:
@@ -206,10 +213,14 @@ def _simulate_one(
     label: str,
     controller: str,
     baseline: _Baseline | None = None,
+    live: LiveSession | None = None,
 ) -> RunResult:
-    meshcat = make_meshcat() if record else None
+    if live is not None:
+        meshcat, make_human = live.meshcat, live.make_human
+    else:
+        meshcat, make_human = (make_meshcat() if record else None), None
     t_build = time.perf_counter()
-    built = build_diagram(scenario, meshcat, controller)
+    built = build_diagram(scenario, meshcat, controller, make_human)
     build_time_s = time.perf_counter() - t_build
 
     simulator = Simulator(built.diagram)
@@ -226,7 +237,7 @@ def _simulate_one(
     if meshcat is not None:
         vis = scenario.visualization
         meshcat.SetCameraPose(np.array(vis.camera_xyz_m), np.array(vis.target_xyz_m))
-        built.visualizer.StartRecording(set_transforms_while_recording=False)
+        built.visualizer.StartRecording(set_transforms_while_recording=live is not None)
 
     failure_reason = None
     bar = ProgressBar(scenario.duration_s, label) if progress else None
@@ -239,6 +250,8 @@ def _simulate_one(
         chunk_s = step_s * max(1, round(chunk_s / step_s))
     try:
         simulator.Initialize()
+        if live is not None:
+            live.started(simulator, built, fall)
         chunk = 0
         while root_context.get_time() < scenario.duration_s - 1e-9:
             chunk += 1
@@ -251,9 +264,13 @@ def _simulate_one(
             if status.reason() == status.ReturnReason.kReachedTerminationCondition:
                 failure_reason = fall.reason
                 break
+            if live is not None and live.after_chunk(simulator, built):
+                break
     except RuntimeError as err:
         failure_reason = "simulation error: " + " ".join(str(err).split())[:300]
     wall_time_s = time.perf_counter() - t_wall
+    if live is not None and failure_reason is None:
+        failure_reason = live.fell  # a fall that no Reset undid
     if bar is not None:
         bar.close()
 
@@ -350,6 +367,11 @@ class _FallMonitor:
         self._max_streak_s = scenario.fall.max_qp_failure_streak_s
         self._failing_since: float | None = None
         self.reason: str | None = None
+
+    def reset(self) -> None:
+        """Forgets a fall and a run of QP failures (the live mode's Reset)."""
+        self._failing_since = None
+        self.reason = None
 
     def __call__(self, root_context) -> EventStatus:
         context = self._plant.GetMyContextFromRoot(root_context)

@@ -2,6 +2,7 @@
 
     1 balance seated     -> 2 after balance_time_s, and with trigger 'hands'
                               once both hands feel a forward pull > threshold
+                              or the stand_up input says go (live mode's button)
     2 CoM forward, the buttocks unloaded over seat_unload_s
                          -> 3 after min_time_state2_s, the state-2 segment done,
                               feet normal forces together > feet_force_2to3_N,
@@ -126,6 +127,9 @@ class Measurements:
     heel_x: float
     foot_fz_N: tuple[float, float]  # left, right
     hand_fx_N: tuple[float, float]  # left, right
+    # Someone asked for the stand-up (live mode's "Stand up" button): with
+    # trigger 'hands', as good as the pull.
+    stand_up: bool = False
 
 
 def initial_mode(com0_W: np.ndarray) -> StandupMode:
@@ -187,7 +191,8 @@ def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> Standup
         # The thighs still on the chair: sit back and wait.
         return _reseat(mode, m, cfg)
     if mode.state == 1:
-        go = dwell >= cfg.balance_time_s and (cfg.trigger == "time" or g.hands_pulled.on)
+        asked = cfg.trigger == "time" or g.hands_pulled.on or m.stand_up
+        go = dwell >= cfg.balance_time_s and asked
         go = go and calm and (segment_done or not any(mode.delta_m))
     elif mode.state == 2:
         go = (
@@ -294,7 +299,8 @@ class StandupStateMachine(LeafSystem):
     """Periodic (update_period_s) state machine with the mode as abstract state.
 
     Inputs: psi (1), com_W (3), heel_x_W (1), pad_forces_W (3 per pad, rows of
-    the soles given as sole_rows = (left, right)), hand_wrenches_W (12).
+    the soles given as sole_rows = (left, right)), hand_wrenches_W (12), and
+    stand_up (1; > 0.5: go; unconnected: never), which only the live helper has.
     Outputs: standup_state (1), segment (8: [psi_entry, T, x_start, delta]),
     contact_plan (6: [state, seat_scale, feet_scale, then what is left of the
     load of the seat, left thigh, right thigh (seat_unloading; NaN: seated)]),
@@ -314,6 +320,7 @@ class StandupStateMachine(LeafSystem):
         self._heel = self.DeclareVectorInputPort("heel_x_W", 1)
         self._pads = self.DeclareVectorInputPort("pad_forces_W", 3 * n_pads)
         self._hands = self.DeclareVectorInputPort("hand_wrenches_W", 12)
+        self._stand_up = self.DeclareVectorInputPort("stand_up", 1)
         self.DeclareInitializationUnrestrictedUpdateEvent(self._Initialize)
         self.DeclarePeriodicUnrestrictedUpdateEvent(config.update_period_s, 0.0, self._Update)
         mode_only = {self.abstract_state_ticket(self._mode_index)}
@@ -361,6 +368,7 @@ class StandupStateMachine(LeafSystem):
             heel_x=float(self._heel.Eval(context)[0]),
             foot_fz_N=(float(pads[left, 2]), float(pads[right, 2])),
             hand_fx_N=(float(hands[0, 3]), float(hands[1, 3])),
+            stand_up=self._stand_up.HasValue(context) and self._stand_up.Eval(context)[0] > 0.5,
         )
 
     def _Update(self, context: Context, state: State) -> None:

@@ -379,3 +379,16 @@ def test_time_held_back_accumulates_while_hindered():
     # On after the filter and the dwell, off likewise: about 2 s in all.
     assert mode.held_back_s == pytest.approx(2.0, abs=0.1)
     assert not mode.guards.hindered.on
+
+
+def test_stand_up_request_starts_like_the_pull_after_the_balance_time():
+    """The live page's "Stand up" (Measurements.stand_up) with trigger 'hands' and no
+    pull: state 2 once the balance time is over, not before; without the request the
+    robot stays seated; a pull against the stand-up still holds it."""
+    mode = initial_mode(COM0)
+    t = CFG.balance_time_s
+    asked = dataclasses.replace(_m(t, hands=(0.0, 0.0)), stand_up=True)
+    assert _next(mode, asked).state == 2
+    assert _next(mode, dataclasses.replace(asked, t=t - 0.1)).state == 1
+    assert _next(mode, dataclasses.replace(asked, stand_up=False)).state == 1
+    assert _next(mode, dataclasses.replace(asked, hand_fx_N=(-10.0, -10.0))).state == 1

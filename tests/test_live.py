@@ -1,0 +1,414 @@
+"""The live mode, headless: the page's sliders, switch, buttons and gamepad driven
+through Drake's Meshcat API (no browser), the pull checked where the plant and the
+rest of the diagram receive it, and the advancement's response to it."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import msgpack
+import numpy as np
+import pytest
+from pydrake.math import RigidTransform
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource
+
+from drake_standup.config import SCENARIO_DIR, HumanConfig, Scenario, load_scenario
+from drake_standup.diagram import build_diagram
+from drake_standup.human import HumanWrenchSource
+from drake_standup.live import (
+    RESET,
+    SLIDERS,
+    STAND_UP,
+    STOP,
+    TOGETHER,
+    LiveHumanSource,
+    LiveSession,
+    gamepad_pull,
+    make_live_meshcat,
+)
+from drake_standup.robot import ContactModel, add_icub
+from drake_standup.scene import set_seated_state
+from drake_standup.simulate import simulate
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def _click(meshcat, button: str) -> None:
+    """What the page sends when a button is clicked."""
+    meshcat._InjectWebsocketMessage(msgpack.packb({"type": "button", "name": button}))
+
+
+def _set_pull(meshcat, left, right=None) -> None:
+    """Sliders [forward, up] per hand, N; right None: both hands together."""
+    meshcat.SetSliderValue(TOGETHER, 1.0 if right is None else 0.0)
+    for hand, pull in (("left", left), ("right", right)):
+        if pull is not None:
+            meshcat.SetSliderValue(SLIDERS[hand, "fwd"], pull[0])
+            meshcat.SetSliderValue(SLIDERS[hand, "up"], pull[1])
+
+
+class _Live:
+    """The live diagram of a scenario, stepped by hand (simulate()'s setup)."""
+
+    def __init__(self, scenario: Scenario):
+        self.scenario = scenario
+        self.meshcat = make_live_meshcat()
+        self.session = LiveSession(scenario, self.meshcat, report=lambda line: None)
+        self.built = build_diagram(scenario, self.meshcat, make_human=self.session.make_human)
+        self.simulator = Simulator(self.built.diagram)
+        ApplySimulatorConfig(scenario.simulator, self.simulator)
+        self.root = self.simulator.get_mutable_context()
+        self.plant = self.built.scene.plant
+        self.plant_context = self.plant.GetMyMutableContextFromRoot(self.root)
+        set_seated_state(self.built.scene, self.plant_context, scenario)
+        self.simulator.Initialize()
+        self.session.started(self.simulator, self.built)
+        self.human = self.built.diagram.GetSubsystemByName("human")
+        self.step = scenario.plant.time_step
+
+    def advance(self, duration_s: float) -> bool:
+        """Simulates duration_s more, then what simulate() does after a chunk."""
+        self.simulator.AdvanceTo(self.root.get_time() + duration_s)
+        return self.session.after_chunk(self.simulator, self.built)
+
+    def applied(self) -> np.ndarray:
+        """(2, 3) the forces on the hands' bodies in the plant's applied-force input."""
+        robot = self.built.scene.robot
+        bodies = [robot.frame(self.plant, h).body().index() for h in ("l_hand", "r_hand")]
+        got = np.zeros((2, 3))
+        for f in self.plant.get_applied_spatial_force_input_port().Eval(self.plant_context):
+            assert not f.F_Bq_W.rotational().any()
+            got[bodies.index(f.body_index)] += f.F_Bq_W.translational()
+        return got
+
+    def measured(self) -> np.ndarray:
+        """(2, 3) hand_wrenches_W's forces, as the rest of the diagram reads them."""
+        port = self.human.GetOutputPort("hand_wrenches_W")
+        return port.Eval(self.human.GetMyContextFromRoot(self.root)).reshape(2, 6)[:, 3:]
+
+    def output(self, system: str, port: str) -> np.ndarray:
+        s = self.built.diagram.GetSubsystemByName(system)
+        return s.GetOutputPort(port).Eval(s.GetMyContextFromRoot(self.root))
+
+
+def _world(pull) -> np.ndarray:
+    return np.array([pull[0], 0.0, pull[1]])
+
+
+def test_gamepad_sticks_map_to_the_pull():
+    """Standard mapping: right and up on a stick are a forward and an upward pull on
+    its hand, full deflection the cap, the dead zone nothing."""
+    np.testing.assert_array_equal(
+        gamepad_pull([1.0, -1.0, 0.05, 0.5], 20.0), [[20.0, 20.0], [0.0, -10.0]]
+    )
+    np.testing.assert_array_equal(gamepad_pull([], 20.0), np.zeros((2, 2)))
+
+
+def test_live_human_has_the_scripted_humans_ports():
+    """The rest of the diagram does not change: same ports, same sizes."""
+    scenario = Scenario()
+    built = build_diagram(scenario)
+    scripted = built.diagram.GetSubsystemByName("human")
+    live = LiveHumanSource(
+        built.scene.plant, built.scene.robot, HumanConfig(), make_live_meshcat(), 0.004
+    )
+    for kind in ("input", "output"):
+        count = getattr(scripted, f"num_{kind}_ports")()
+        for i in range(count):
+            port = getattr(scripted, f"get_{kind}_port")(i)
+            twin = getattr(live, f"Get{kind.capitalize()}Port")(port.get_name())
+            assert (twin.get_data_type(), twin.size()) == (port.get_data_type(), port.size())
+
+
+def test_sliders_reach_the_plant_and_the_hand_wrenches_within_one_step():
+    """A pull set on the page's sliders is, one plant step later, the force the
+    plant applies at each hand and the wrench the other systems measure; the switch
+    makes the right hand follow the left (and its sliders show it); a slider beyond
+    the cap is held at the cap."""
+    live = _Live(load_scenario(SCENARIO_DIR / "assisted.yaml"))
+    live.advance(0.1)
+    np.testing.assert_array_equal(live.applied(), np.zeros((2, 3)))
+    _set_pull(live.meshcat, (12.0, 7.5), (-3.0, 4.0))
+    live.advance(live.step)
+    expected = np.array([_world((12.0, 7.5)), _world((-3.0, 4.0))])
+    np.testing.assert_array_equal(live.applied(), expected)
+    np.testing.assert_array_equal(live.measured(), expected)
+
+    _set_pull(live.meshcat, (9.0, 2.0))  # together
+    live.advance(live.step)
+    np.testing.assert_array_equal(live.applied(), [_world((9.0, 2.0))] * 2)
+    assert live.meshcat.GetSliderValue(SLIDERS["right", "fwd"]) == 9.0
+
+    cap = live.scenario.human.reactive.force_cap_N
+    _set_pull(live.meshcat, (100.0, -100.0))
+    live.advance(live.step)
+    np.testing.assert_array_equal(live.measured(), [_world((cap, -cap))] * 2)
+
+
+def test_a_slider_pull_changes_momentum_by_its_impulse():
+    """Zero gravity, no contact, a limp floating robot pulled from the sliders: its
+    linear momentum grows by F (T - dt) (Newton's second law; the first step still
+    sees the pull of before the update). As in test_human's scripted twin, within
+    1%: the limp robot's joints settle onto their limits in the first steps, a
+    transient of ~0.2 N s in the discrete plant's momentum (the same with the
+    scripted human), small against 2 s of pull."""
+    builder = DiagramBuilder()
+    dt = 1e-3
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=dt)
+    robot = add_icub(plant, visuals=False, contact=ContactModel())
+    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
+    plant.Finalize()
+    meshcat = make_live_meshcat()
+    human = builder.AddSystem(LiveHumanSource(plant, robot, HumanConfig(), meshcat, dt))
+    builder.Connect(
+        human.GetOutputPort("spatial_forces"), plant.get_applied_spatial_force_input_port()
+    )
+    builder.Connect(
+        plant.get_state_output_port(robot.model_instance), human.GetInputPort("robot_state")
+    )
+    zero = builder.AddSystem(ConstantVectorSource(np.zeros(plant.num_actuated_dofs())))
+    builder.Connect(zero.get_output_port(), plant.get_actuation_input_port())
+    simulator = Simulator(builder.Build())
+    plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+    plant.SetFreeBodyPose(
+        plant_context, plant.GetBodyByName("root_link"), RigidTransform([0, 0, 3])
+    )
+    _set_pull(meshcat, (10.0, 5.0), (10.0, 5.0))
+    t_end = 2.0
+    simulator.AdvanceTo(t_end)
+    mass = plant.CalcTotalMass(plant_context)
+    momentum = mass * plant.CalcCenterOfMassTranslationalVelocityInWorld(plant_context)
+    impulse = 2 * _world((10.0, 5.0)) * (t_end - dt)
+    assert np.linalg.norm(momentum - impulse) < 0.01 * np.linalg.norm(impulse)
+
+
+def _quick(trigger: str = "hands") -> Scenario:
+    """The assisted scenario with a short balance time: the stand-up may start at 0.2 s."""
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
+    scenario.standup.trigger = trigger
+    scenario.standup.balance_time_s = 0.2
+    return scenario
+
+
+def test_stand_up_button_starts_the_stand_up_and_reset_puts_the_robot_back():
+    """With trigger 'hands' and nobody pulling, the robot waits; "Stand up" starts
+    it (state 2 at the state machine's next update past the balance time). "Reset"
+    puts every state back to t = 0's (the seated robot, psi, the helper's latch) with
+    time running on, the state machine's clock restarted; the old click no longer
+    counts. "Stop" ends the run."""
+    live = _Live(_quick())
+    assert live.human.HasOutputPort("stand_up")
+    q0 = live.plant.GetPositions(live.plant_context).copy()
+    live.advance(0.4)
+    assert live.output("state_machine", "standup_state")[0] == 1
+    _click(live.meshcat, STAND_UP)
+    live.advance(0.1)
+    assert live.output("state_machine", "standup_state")[0] == 2
+    live.advance(0.5)
+    assert not np.allclose(live.plant.GetPositions(live.plant_context), q0, atol=1e-3)
+
+    _click(live.meshcat, RESET)
+    assert not live.advance(live.step)  # after_chunk sees the click and resets
+    t_reset = live.root.get_time()
+    np.testing.assert_array_equal(live.plant.GetPositions(live.plant_context), q0)
+    assert live.output("state_machine", "standup_state")[0] == 1
+    assert live.output("state_machine", "entry_times_s")[0] == t_reset
+    assert live.output("advancement", "psi")[0] == 0.0
+    assert live.output("human", "stand_up")[0] == 0.0
+    live.advance(0.5)  # past the balance time again: the old click does not count
+    assert live.output("state_machine", "standup_state")[0] == 1
+    assert live.root.get_time() > t_reset
+
+    _click(live.meshcat, STOP)
+    assert live.advance(live.step)
+    assert live.session.stopped_by == "the Stop button"
+
+
+class _Pulling(LiveSession):
+    """A helper who sets the sliders before the run starts."""
+
+    def __init__(self, scenario, pull):
+        super().__init__(scenario, make_live_meshcat(), report=lambda line: None)
+        self._pull = pull
+
+    def started(self, simulator, built, fall=None) -> None:
+        super().started(simulator, built, fall)
+        _set_pull(self.meshcat, self._pull)
+
+
+@pytest.mark.slow
+def test_a_helpful_slider_pull_advances_psi_and_a_backward_one_does_not():
+    """15 N forward + 15 N up on both hands from the sliders (the default scripted
+    pull) runs psi_dot past 1 while the robot rises; 1.5 N backwards on each hand
+    (3 N together, below the hindering threshold, so the stand-up goes on) leaves
+    psi_dot at exactly 1 (psi = t) through the same rise. (3 N backwards on each
+    hand, held from the start of state 2, topples the robot: measured, issue 15's
+    report.)"""
+    runs = {}
+    for name, pull in (("helpful", (15.0, 15.0)), ("backward", (-1.5, 0.0))):
+        scenario = _quick("time")
+        scenario.duration_s = 2.5
+        scenario.simulator.target_realtime_rate = 0.0  # as fast as it goes
+        session = _Pulling(scenario, pull)
+        result = simulate(scenario, None, progress=False, live=session)
+        runs[name] = result.signals
+        np.testing.assert_allclose(
+            result.signals["hand_wrenches_W"][-1].reshape(2, 6)[:, 3:], [_world(pull)] * 2
+        )
+    helpful, backward = runs["helpful"], runs["backward"]
+    assert helpful["psi_dot"].max() > 1.5
+    assert backward["state"].max() >= 3  # the robot rose against the pull
+    assert backward["psi_dot"].min() == 1.0 and backward["psi_dot"].max() == 1.0
+    np.testing.assert_array_equal(backward["psi"], backward["time_s"])
+
+
+class _Toppling(_Pulling):
+    """A helper who pulls 3 N back on each hand (below the hindering threshold: the
+    robot falls in state 2, README "Be the helper"), lets go and clicks Reset once
+    the console says it fell."""
+
+    def __init__(self, scenario):
+        super().__init__(scenario, (-3.0, 0.0))
+        self.lines = []
+        self._report = self.lines.append
+        self.reset_at = None
+
+    def after_chunk(self, simulator, built) -> bool:
+        if self.fell is not None and self.reset_at is None:
+            _set_pull(self.meshcat, (0.0, 0.0))
+            _click(self.meshcat, RESET)
+            self.reset_at = simulator.get_context().get_time()
+        return super().after_chunk(simulator, built)
+
+
+@pytest.mark.slow
+def test_a_live_run_goes_on_after_a_fall_and_reset_stands_the_robot_up_again():
+    """The fall is reported once and does not end the run; after Reset, nobody
+    pulling, the robot stands up on its own (trigger time) and stands at the end."""
+    scenario = _quick("time")
+    scenario.duration_s = 6.0
+    scenario.simulator.target_realtime_rate = 0.0
+    session = _Toppling(scenario)
+    result = simulate(scenario, None, progress=False, live=session)
+    assert [line for line in session.lines if line.startswith("fall:")] == session.lines[:1]
+    assert session.reset_at is not None and session.reset_at < 2.0
+    m = result.metrics
+    assert m["sim_time_s"] == pytest.approx(6.0)
+    assert m["state_entry_times_s"][1] > session.reset_at  # the stand-up after the Reset
+    assert m["success"], m["failure_reason"]
+
+
+@pytest.mark.slow
+def test_a_fall_no_reset_undid_is_the_runs_failure_reason():
+    """The same toppling pull, nobody clicking Reset: the run goes on to its end and
+    metrics.json's failure_reason is the fall the console reported."""
+    scenario = _quick("time")
+    scenario.duration_s = 2.0
+    scenario.simulator.target_realtime_rate = 0.0
+    session = _Pulling(scenario, (-3.0, 0.0))
+    lines = []
+    session._report = lines.append
+    result = simulate(scenario, None, progress=False, live=session)
+    assert result.metrics["sim_time_s"] == pytest.approx(2.0)
+    assert result.metrics["failure_reason"].startswith("fall: root_link height")
+    assert lines == [f"{result.metrics['failure_reason']}; Reset puts the robot back on the chair"]
+
+
+@pytest.mark.slow
+def test_run_diagram_live_prints_one_address_and_writes_the_outputs(tmp_path):
+    """The command as a user types it: one line with the page's address (Drake's own
+    log line about it silenced), paced at real time, exit 0, the normal outputs."""
+    out = tmp_path / "live"
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    done = subprocess.run(
+        [sys.executable, "run_diagram.py", "--live", "--duration", "0.5", "--out", str(out)],
+        cwd=REPO,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    lines = (done.stdout + done.stderr).splitlines()
+    addresses = [line for line in lines if "localhost:" in line]
+    assert len(addresses) == 1 and addresses[0].startswith("meshcat: http://localhost:")
+    for name in ("metrics.json", "signals.npz", "recording.html", "figure_advancement.png"):
+        assert (out / name).is_file()
+    import json
+
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["sim_time_s"] == pytest.approx(0.5)
+    assert metrics["wall_time_s"] >= 0.5 - 0.02  # paced: not faster than real time
+
+
+def test_live_with_no_recording_is_one_error_line():
+    done = subprocess.run(
+        [sys.executable, "run_diagram.py", "--live", "--no-recording"],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 2
+    assert done.stderr.startswith("error: ") and len(done.stderr.strip().splitlines()) == 1
+
+
+def test_human_wrench_source_unchanged_by_the_live_mode():
+    """The scripted human has no stand_up port: the normal diagram's state machine
+    leaves that input unconnected."""
+    built = build_diagram(Scenario())
+    assert not built.diagram.GetSubsystemByName("human").HasOutputPort("stand_up")
+    assert isinstance(built.diagram.GetSubsystemByName("human"), HumanWrenchSource)
+
+
+class _FakeSimulator:
+    """What LiveSession's pacing reads of a Simulator: time, the target rate, and
+    ResetStatistics (Drake's pacing restarts there)."""
+
+    def __init__(self):
+        self.t = 0.0
+        self.restarts = []
+
+    def get_target_realtime_rate(self) -> float:
+        return 1.0
+
+    def get_context(self):
+        return self
+
+    def get_time(self) -> float:
+        return self.t
+
+    def ResetStatistics(self) -> None:
+        self.restarts.append(self.t)
+
+
+def test_pacing_reports_the_achieved_rate_once_a_second_and_never_catches_up(monkeypatch):
+    """A machine at half real time: one line a second with the rate over that second
+    (0.50x), and the pacing restarted whenever the simulation lags the wall clock by
+    more than MAX_LAG_S; at real time, nothing is said."""
+    from drake_standup import live
+
+    wall = [100.0]
+    monkeypatch.setattr(live.time, "perf_counter", lambda: wall[0])
+    lines = []
+    session = LiveSession(Scenario(), make_live_meshcat(), report=lines.append)
+    sim = _FakeSimulator()
+    session._restart_clocks(sim)
+    for _ in range(32):  # 2 s of wall time, 1 s simulated (binary fractions: exact)
+        wall[0] += 1 / 16
+        sim.t += 1 / 32
+        session._pace(sim)
+    assert lines == ["behind real time: 0.50x at t = 0.5 s", "behind real time: 0.50x at t = 1.0 s"]
+    assert len(sim.restarts) == 8  # every 0.25 s of wall time: 0.125 s behind
+    lines.clear()
+    for _ in range(32):  # real time
+        wall[0] += 1 / 16
+        sim.t += 1 / 16
+        session._pace(sim)
+    assert lines == [] and len(sim.restarts) == 8
