@@ -225,18 +225,21 @@ class StandupConfig:
     # in state 2, or in state 3 while the thighs still carry most of their load
     # (reseat_above_thigh_load), it sits back into state 1; later in state 3 it
     # holds. psi = t meanwhile (the pull does not help). Issue 13: 10 N backwards
-    # per hand toppled the robot over the chair. N.
-    hindering_force_threshold_N: float = 8.0
+    # per hand toppled the robot over the chair; in state 2 so did 2 N per hand
+    # (4 N together, under the first threshold of 8 N), while 1 N per hand stood
+    # up (measured). N.
+    hindering_force_threshold_N: float = 2.5
     # Once a hindering pull has stopped, the stand-up waits this long before it
     # (re)starts from state 1 or goes on from state 3: the pull is over, not
     # paused, and the arms it swung back return to their posture first. s.
     resume_after_s: float = 0.5
     # In state 3 a hindering pull sits the robot back while the thighs' release
     # has left them more than this fraction of their load (the plan's smoothstep);
-    # later state 3 holds. Sat back with the thighs at 0.4 of their load, the
-    # robot's feet were left unloaded on the chair and its next attempt fell back;
-    # holding there, it stood (measured, 15 N per hand).
-    reseat_above_thigh_load: float = 0.5
+    # later state 3 holds. Sat back with the thighs at 0.4 or 0.7 of their load,
+    # the robot sat further forward on the chair and its next attempt fell back;
+    # holding there, it stood. With the thighs at 0.95 sitting back worked, holding
+    # fell (measured, 15 N per hand).
+    reseat_above_thigh_load: float = 0.9
     # Min-jerk segment lengths of states 2, 3, 4 in units of psi (= s when
     # psi = t); the advancement version's [1.5, 0.5, 1.8] (SPEC 3).
     segment_psi: list[float] = field(default_factory=lambda: [1.5, 0.5, 1.8])

@@ -245,13 +245,13 @@ class _Pulling(LiveSession):
 @pytest.mark.slow
 def test_a_helpful_slider_pull_advances_psi_and_a_backward_one_does_not():
     """15 N forward + 15 N up on both hands from the sliders (the default scripted
-    pull) runs psi_dot past 1 while the robot rises; 1.5 N backwards on each hand
-    (3 N together, below the hindering threshold, so the stand-up goes on) leaves
-    psi_dot at exactly 1 (psi = t) through the same rise. (3 N backwards on each
-    hand, held from the start of state 2, topples the robot: measured, issue 15's
-    report.)"""
+    pull) runs psi_dot past 1 while the robot rises; 1 N backwards on each hand
+    (2 N together, below the 2.5 N hindering threshold, so the stand-up goes on)
+    leaves psi_dot at exactly 1 (psi = t) through the same rise. (3 N backwards on
+    each hand, held from the start of state 2, toppled the robot under the first
+    8 N threshold: issue 15's report; it now waits.)"""
     runs = {}
-    for name, pull in (("helpful", (15.0, 15.0)), ("backward", (-1.5, 0.0))):
+    for name, pull in (("helpful", (15.0, 15.0)), ("backward", (-1.0, 0.0))):
         scenario = _quick("time")
         scenario.duration_s = 2.5
         scenario.simulator.target_realtime_rate = 0.0  # as fast as it goes
@@ -269,9 +269,9 @@ def test_a_helpful_slider_pull_advances_psi_and_a_backward_one_does_not():
 
 
 class _Toppling(_Pulling):
-    """A helper who pulls 3 N back on each hand (below the hindering threshold: the
-    robot falls in state 2, README "Be the helper"), lets go and clicks Reset once
-    the console says it fell."""
+    """A helper who pulls 3 N back on each hand, with the hindering hold switched off
+    (toppling_scenario: the robot then falls in state 2), lets go and clicks Reset
+    once the console says it fell."""
 
     def __init__(self, scenario):
         super().__init__(scenario, (-3.0, 0.0))
@@ -287,13 +287,21 @@ class _Toppling(_Pulling):
         return super().after_chunk(simulator, built)
 
 
+def _toppling_scenario(duration_s: float):
+    """The quick scenario with the hindering hold off (a threshold no pull reaches): 3 N
+    back per hand then topples the robot in state 2 (measured), a fall to recover from."""
+    scenario = _quick("time")
+    scenario.duration_s = duration_s
+    scenario.simulator.target_realtime_rate = 0.0
+    scenario.standup.hindering_force_threshold_N = 1.0e3
+    return scenario
+
+
 @pytest.mark.slow
 def test_a_live_run_goes_on_after_a_fall_and_reset_stands_the_robot_up_again():
     """The fall is reported once and does not end the run; after Reset, nobody
     pulling, the robot stands up on its own (trigger time) and stands at the end."""
-    scenario = _quick("time")
-    scenario.duration_s = 6.0
-    scenario.simulator.target_realtime_rate = 0.0
+    scenario = _toppling_scenario(6.0)
     session = _Toppling(scenario)
     result = simulate(scenario, None, progress=False, live=session)
     assert [line for line in session.lines if line.startswith("fall:")] == session.lines[:1]
@@ -308,9 +316,7 @@ def test_a_live_run_goes_on_after_a_fall_and_reset_stands_the_robot_up_again():
 def test_a_fall_no_reset_undid_is_the_runs_failure_reason():
     """The same toppling pull, nobody clicking Reset: the run goes on to its end and
     metrics.json's failure_reason is the fall the console reported."""
-    scenario = _quick("time")
-    scenario.duration_s = 2.0
-    scenario.simulator.target_realtime_rate = 0.0
+    scenario = _toppling_scenario(2.0)
     session = _Pulling(scenario, (-3.0, 0.0))
     lines = []
     session._report = lines.append

@@ -121,21 +121,22 @@ def test_a_hindering_pull_waits_seated_and_the_robot_stands_up_once_it_stops():
 
 
 @pytest.mark.parametrize(
-    "start_s",
-    [1.0, 3.5, 4.6, 5.2, 8.0],
-    ids=["seated", "in_state_2", "in_state_3", "in_state_4", "standing"],
+    ("start_s", "force_N"),
+    [(1.0, 15.0), (3.5, 15.0), (4.6, 15.0), (5.2, 15.0), (8.0, 15.0), (3.2, 2.0)],
+    ids=["seated", "in_state_2", "in_state_3", "in_state_4", "standing", "2N_in_state_2"],
 )
-def test_a_hindering_pull_in_any_state_does_not_topple_it(start_s):
+def test_a_hindering_pull_in_any_state_does_not_topple_it(start_s, force_N):
     """Issue 13: 15 N backwards on each hand for 4 s, started before the stand-up (1.0 s),
     inside state 2 (3.5 s: it sits back and waits), state 3 (4.6 s: it holds there),
     state 4 (5.2 s) or on the standing robot (8.0 s: it leans into the pull within its
     feet). No fall, psi = t throughout, and it ends standing erect (before the lean was
-    bounded by the feet it fell when the pull stopped)."""
+    bounded by the feet it fell when the pull stopped). 2 N per hand in state 2 toppled
+    the robot under the first 8 N threshold of the hold; it now sits back too."""
     from drake_standup.config import Pull
 
     scenario = load_scenario(SCENARIO_DIR / "unassisted.yaml")
     scenario.human.pulls = [
-        Pull(hand=hand, start_s=start_s, duration_s=4.0, ramp_s=0.3, force_N=[-15.0, 0.0, 0.0])
+        Pull(hand=hand, start_s=start_s, duration_s=4.0, ramp_s=0.3, force_N=[-force_N, 0.0, 0.0])
         for hand in ("left", "right")
     ]
     scenario.duration_s = max(scenario.duration_s, start_s + 4.0 + 5.0)
