@@ -739,7 +739,16 @@ def validate(scenario: Scenario) -> Scenario:
             f"robot.model: unknown model '{scenario.robot.model}'; "
             f"accepted: {', '.join(robot_names())}"
         )
-    _check_rates(scenario.plant.time_step, scenario.controller_period_s)
+    # The controller's period is a whole multiple of a discrete plant's step: the plant
+    # reads its actuation input only at its own steps, so a faster controller is wasted
+    # work and a period off the plant's grid jitters.
+    step, period = scenario.plant.time_step, scenario.controller_period_s
+    ratio = period / step if step > 0 else 1.0  # a continuous plant: any period
+    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+        raise ScenarioError(
+            f"controller_period_s: {period}; accepted: a whole multiple of plant.time_step "
+            f"({step}), e.g. {step} or {2 * step}"
+        )
     if not chair_file(scenario.chair.file).is_file():
         raise ScenarioError(
             f"chair.file: '{scenario.chair.file}' not found; accepted: an SDF file path "
@@ -751,39 +760,22 @@ def validate(scenario: Scenario) -> Scenario:
                 f"human.pulls[{i}].ramp_s: {pull.ramp_s}; accepted: at most half of "
                 f"duration_s ({pull.duration_s / 2})"
             )
-    _validate_path(scenario.human.reactive)
-    return scenario
-
-
-def _check_rates(time_step: float, period_s: float) -> None:
-    """The controller's period is a whole multiple of a discrete plant's step:
-    the plant reads its actuation input only at its own steps, so a faster
-    controller is wasted work and a period off the plant's grid jitters."""
-    if time_step == 0.0:
-        return
-    ratio = period_s / time_step
-    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+    reactive = scenario.human.reactive
+    if not reactive.path_xz_m:
         raise ScenarioError(
-            f"controller_period_s: {period_s}; accepted: a whole multiple of plant.time_step "
-            f"({time_step}), e.g. {time_step} or {2 * time_step}"
-        )
-
-
-def _validate_path(r: ReactiveHumanConfig) -> None:
-    key = "human.reactive"
-    if not r.path_xz_m:
-        raise ScenarioError(
-            f"{key}.path_xz_m: empty; accepted: a list of [forward, up] waypoints, m"
+            "human.reactive.path_xz_m: empty; accepted: a list of [forward, up] waypoints, m"
         )
     previous = [0.0, 0.0]
-    for i, point in enumerate(r.path_xz_m):
+    for i, point in enumerate(reactive.path_xz_m):
         if math.dist(point, previous) < 1e-3:
             raise ScenarioError(
-                f"{key}.path_xz_m[{i}]: {point}; accepted: a waypoint at least 1 mm from "
-                f"the one before ({previous}; the path starts at [0, 0])"
+                f"human.reactive.path_xz_m[{i}]: {point}; accepted: a waypoint at least 1 mm "
+                f"from the one before ({previous}; the path starts at [0, 0])"
             )
         previous = point
-    if not r.lead_max_m >= r.lead_min_m:
+    if not reactive.lead_max_m >= reactive.lead_min_m:
         raise ScenarioError(
-            f"{key}.lead_max_m: {r.lead_max_m}; accepted: a number >= lead_min_m ({r.lead_min_m})"
+            f"human.reactive.lead_max_m: {reactive.lead_max_m}; accepted: a number >= "
+            f"lead_min_m ({reactive.lead_min_m})"
         )
+    return scenario
