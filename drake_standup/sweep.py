@@ -93,11 +93,8 @@ def run_sweep(
 
     def on_result(run: RunSpec, metrics: dict | None, lost: BaseException | None) -> dict:
         if lost is not None:
-            text = " ".join(str(lost).split())
-            metrics = {
-                "success": False,
-                "failure_reason": f"cluster: {type(lost).__name__}: {text}"[:300],
-            }
+            reason = f"cluster: {type(lost).__name__}: {' '.join(str(lost).split())}"
+            metrics = {"success": False, "failure_reason": reason[:300]}
         record = {**asdict(run), "metrics": metrics, "retry": lost is not None}
         write_json(runs_dir / f"{run.run_id}.json", record)
         records[run.run_id] = record

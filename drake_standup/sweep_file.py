@@ -177,9 +177,8 @@ def _parameters(raw: dict, key: str) -> list[Parameter]:
     params = []
     for i, entry in enumerate(entries):
         where = f"{key}[{i}]"
-        paths = _known(where, entry, ("name", "path", "paths", kind)).get(
-            "paths", entry.get("path")
-        )
+        _known(where, entry, ("name", "path", "paths", kind))
+        paths = entry.get("paths", entry.get("path"))
         paths = [paths] if isinstance(paths, str) else paths
         if not paths or not isinstance(paths, list) or not all(isinstance(p, str) for p in paths):
             raise SweepError(
