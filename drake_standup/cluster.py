@@ -9,27 +9,26 @@ import time
 
 
 def open_client(workers: int, address: str | None):
-    """A Dask client: on the scheduler at address, or on a new LocalCluster of
-    `workers` single-threaded worker processes listening on localhost only."""
-    from distributed import Client, LocalCluster
+    """A Dask client: on the scheduler at address, or on a LocalCluster of its own (closed
+    with the client) of `workers` single-threaded worker processes on localhost only."""
+    from distributed import Client
 
-    if address:
-        client = Client(address, timeout="30s")
-        try:
-            client.wait_for_workers(1, timeout=60)
-        except TimeoutError:
-            client.close()
-            raise OSError(f"no Dask worker joined the scheduler at {address} in 60 s") from None
-        return client, None
-    cluster = LocalCluster(
-        n_workers=workers,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-    )
-    return Client(cluster), cluster
+    if not address:
+        return Client(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
+    client = Client(address, timeout="30s")
+    try:
+        client.wait_for_workers(1, timeout=60)
+    except TimeoutError:
+        client.close()
+        raise OSError(f"no Dask worker joined the scheduler at {address} in 60 s") from None
+    return client
 
 
 def run_on_cluster(
@@ -51,21 +50,20 @@ def run_on_cluster(
 
     from drake_standup.progress import ProgressBar
 
-    client, cluster = open_client(workers, address)
+    client = open_client(workers, address)
     try:
         futures = {
             client.submit(fn, *args, key=key, pure=False): item for item, key, fn, args in tasks
         }
         bar = ProgressBar(len(tasks), label, unit="runs") if progress else None
         t0 = time.perf_counter()
-        done = failed = 0
-        for future in as_completed(futures):
+        failed = 0
+        for done, future in enumerate(as_completed(futures), start=1):
             item = futures[future]
             if future.status == "finished":
                 metrics = on_result(item, future.result(), None)
             else:
                 metrics = on_result(item, None, future.exception())
-            done += 1
             failed += not metrics.get("success", False)
             future.release()
             if bar is not None:
@@ -75,5 +73,3 @@ def run_on_cluster(
             bar.close()
     finally:
         client.close()
-        if cluster is not None:
-            cluster.close()

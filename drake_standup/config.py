@@ -22,8 +22,8 @@ from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
 from drake_standup.control.qp import SOLVERS
 from drake_standup.controller import ControllerConfig
-from drake_standup.resources import data_root, shipped
-from drake_standup.robot import EFFORT_LIMIT_NM
+from drake_standup.resources import data_root, find, shipped
+from drake_standup.robot import EFFORT_LIMIT_NM, robot_names
 
 SCENARIO_DIR = data_root() / "scenarios"
 DEFAULT_SCENARIO = SCENARIO_DIR / "assisted.yaml"
@@ -435,8 +435,6 @@ class Scenario:
 def load_scenario(path: str | Path | None = None, overrides: Iterable = ()) -> Scenario:
     """Loads a scenario file (a path, or the name of a shipped scenario), applies overrides
     [(key path, value)] and validates; raises ScenarioError (one line)."""
-    from drake_standup.resources import find
-
     found = find("scenarios", path) if path is not None else DEFAULT_SCENARIO
     if found is None:
         raise ScenarioError(
@@ -456,8 +454,7 @@ def parse_scenario(text: str, where: str = "scenario", overrides: Iterable = ())
         raise ScenarioError(
             f"scenario {where}: {raw!r}; accepted: a mapping of {', '.join(_fields(Scenario))}"
         )
-    scenario = _load(text, raw or {}, Scenario()) if raw else Scenario()
-    return apply_overrides(scenario, overrides)
+    return apply_overrides(_load(raw or {}, Scenario()), overrides)
 
 
 def apply_overrides(scenario: Scenario, overrides: Iterable) -> Scenario:
@@ -468,24 +465,19 @@ def apply_overrides(scenario: Scenario, overrides: Iterable) -> Scenario:
     the typed parser, and the errors, of a scenario file. A key path is names joined by
     '.' with [index] for list entries, e.g. human.pulls[0].force_N[2].
     """
-    data = _plain(scenario)
-    layer = {}
+    data, layer = _plain(scenario), {}
     for path, value in overrides:
-        steps = _set(data, path, value)
-        layer[steps[0]] = data[steps[0]]
-    if layer:
-        scenario = _load(yaml.safe_dump(layer), layer, scenario)
-    validate(scenario)
-    return scenario
+        top = _set(data, path, value)
+        layer[top] = data[top]
+    return validate(_load(layer, scenario))
 
 
 def expand_key_path(scenario: Scenario, path: str) -> list[str]:
     """The concrete key paths a path names in scenario ([*]: every entry of a list)."""
     if "[*]" not in path:
         return [path]
-    pattern = _pattern(path)
-    keys = [_format(steps) for steps, _ in _nodes(_plain(scenario))]
-    return [key for key in keys if pattern.fullmatch(key)]
+    keys = (_format(steps) for steps, _ in _nodes(_plain(scenario)))
+    return [key for key in keys if _pattern(path).fullmatch(key)]
 
 
 def chair_file(name: str) -> Path:
@@ -497,17 +489,18 @@ def chair_file(name: str) -> Path:
 # --- Drake's loader, and errors that name the key path -----------------------------------
 
 
-def _load(text: str, raw: dict, defaults: Scenario) -> Scenario:
-    """yaml_load_typed(text) over defaults. Drake's own errors do not say where (nor do
-    its ValueErrors name a key), so on failure each leaf of raw is loaded alone to find
-    the key path to name."""
+def _load(raw: dict, defaults: Scenario) -> Scenario:
+    """yaml_load_typed of raw (plain YAML data) over defaults. Drake's own errors do not say
+    where (nor do its ValueErrors name a key), so on failure each leaf of raw is loaded
+    alone to find the key path to name."""
     try:
+        text = yaml.safe_dump(raw, sort_keys=False)
         return yaml_load_typed(schema=Scenario, data=text, defaults=defaults)
-    except (RuntimeError, ValueError, TypeError, AssertionError) as err:
+    except Exception as err:  # RuntimeError, ValueError, TypeError, AttributeError, ...
         for steps, value in _nodes(raw, leaves=True):
             try:
                 yaml_load_typed(schema=Scenario, data=yaml.safe_dump(_nest(steps, value)))
-            except (RuntimeError, ValueError, TypeError, AssertionError):
+            except Exception:
                 raise ScenarioError(_type_error(steps, raw)) from None
         raise ScenarioError(f"scenario: {_one_line(err)}") from None
 
@@ -515,22 +508,20 @@ def _load(text: str, raw: dict, defaults: Scenario) -> Scenario:
 def _type_error(steps: list, raw: dict) -> str:
     """The message for the leaf at steps that Drake's loader rejected: an unknown key, or
     a value of the wrong type (named at the first step the schema has no room for)."""
-    schema = Scenario
+    schema, value = Scenario, raw
     for depth, step in enumerate(steps):
-        fields = _fields(schema)
-        if isinstance(step, str) and fields is not None and step not in fields:
-            return f"{_format(steps[: depth + 1])}: unknown key; accepted: {', '.join(fields)}"
-        origin, args = typing.get_origin(schema), typing.get_args(schema)
-        if isinstance(step, int) and origin is list:
-            schema = args[0]
-        elif isinstance(step, str) and (fields is not None or origin is dict):
-            schema = fields[step] if fields is not None else args[1]
+        fields, origin = _fields(schema), typing.get_origin(schema)
+        if isinstance(step, str) and fields is not None:
+            if step not in fields:
+                return f"{_format(steps[: depth + 1])}: unknown key; accepted: {', '.join(fields)}"
+            schema = fields[step]
+        elif origin is (list if isinstance(step, int) else dict):
+            schema = typing.get_args(schema)[-1]  # list[T], dict[str, T]: T
         else:
+            steps = steps[:depth]
             break
-    else:
-        depth = len(steps)
-    where = steps[:depth]
-    return f"{_format(where)}: {_node(raw, where)!r}; accepted: {_type_name(schema)}"
+        value = value[step]
+    return f"{_format(steps)}: {value!r}; accepted: {_type_name(schema)}"
 
 
 def _type_name(schema) -> str:
@@ -562,12 +553,6 @@ def _nest(steps: list, value):
     return value
 
 
-def _node(data, steps: list):
-    for step in steps:
-        data = data[step]
-    return data
-
-
 def _one_line(err: Exception) -> str:
     return " ".join(str(err).split())
 
@@ -577,9 +562,9 @@ def _one_line(err: Exception) -> str:
 _KEY_PATH = re.compile(r"[A-Za-z_]\w*(\[\d+\])*(\.[A-Za-z_]\w*(\[\d+\])*)*")
 
 
-def _set(data: dict, path: str, value) -> list[str | int]:
-    """Sets the value at a key path of plain data; returns the path's steps. A mapping may
-    gain a key (Drake's loader then names one its schema lacks), a list no entry."""
+def _set(data: dict, path: str, value) -> str:
+    """Sets the value at a key path of plain data; returns the path's first name. A mapping
+    may gain a key (Drake's loader then names one its schema lacks), a list no entry."""
     if not _KEY_PATH.fullmatch(path):
         raise ScenarioError(
             f"key path '{path}': accepted: names joined by '.', each with an optional [index]"
@@ -596,10 +581,9 @@ def _set(data: dict, path: str, value) -> list[str | int]:
             raise ScenarioError(
                 f"key path '{path}': index {step} out of range; {where} has {len(node)} entries"
             )
-        if depth < len(steps) - 1:
-            node = node[step] if isinstance(step, int) else node.setdefault(step, {})
-    node[steps[-1]] = value
-    return steps
+        parent, node = node, node[step] if isinstance(step, int) else node.setdefault(step, {})
+    parent[steps[-1]] = value
+    return steps[0]
 
 
 def _format(steps: list[str | int]) -> str:
@@ -744,10 +728,9 @@ def _check(key: str, value, accepted) -> None:
         raise ScenarioError(f"{key}: {value}; accepted: {accepted}")
 
 
-def validate(scenario: Scenario) -> None:
-    """Checks what the types alone cannot; raises ScenarioError (one line)."""
-    from drake_standup.robot import robot_names
-
+def validate(scenario: Scenario) -> Scenario:
+    """Checks what the types alone cannot; raises ScenarioError (one line). Returns
+    scenario."""
     for steps, value in _nodes(_plain(scenario)):
         key = _format(steps)
         _check(key, value, None)
@@ -759,7 +742,16 @@ def validate(scenario: Scenario) -> None:
             f"robot.model: unknown model '{scenario.robot.model}'; "
             f"accepted: {', '.join(robot_names())}"
         )
-    _check_rates(scenario.plant.time_step, scenario.controller_period_s)
+    # The controller's period is a whole multiple of a discrete plant's step: the plant
+    # reads its actuation input only at its own steps, so a faster controller is wasted
+    # work and a period off the plant's grid jitters.
+    step, period = scenario.plant.time_step, scenario.controller_period_s
+    ratio = period / step if step > 0 else 1.0  # a continuous plant: any period
+    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+        raise ScenarioError(
+            f"controller_period_s: {period}; accepted: a whole multiple of plant.time_step "
+            f"({step}), e.g. {step} or {2 * step}"
+        )
     if not chair_file(scenario.chair.file).is_file():
         raise ScenarioError(
             f"chair.file: '{scenario.chair.file}' not found; accepted: an SDF file path "
@@ -771,38 +763,22 @@ def validate(scenario: Scenario) -> None:
                 f"human.pulls[{i}].ramp_s: {pull.ramp_s}; accepted: at most half of "
                 f"duration_s ({pull.duration_s / 2})"
             )
-    _validate_path(scenario.human.reactive)
-
-
-def _check_rates(time_step: float, period_s: float) -> None:
-    """The controller's period is a whole multiple of a discrete plant's step:
-    the plant reads its actuation input only at its own steps, so a faster
-    controller is wasted work and a period off the plant's grid jitters."""
-    if time_step == 0.0:
-        return
-    ratio = period_s / time_step
-    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+    reactive = scenario.human.reactive
+    if not reactive.path_xz_m:
         raise ScenarioError(
-            f"controller_period_s: {period_s}; accepted: a whole multiple of plant.time_step "
-            f"({time_step}), e.g. {time_step} or {2 * time_step}"
-        )
-
-
-def _validate_path(r: ReactiveHumanConfig) -> None:
-    key = "human.reactive"
-    if not r.path_xz_m:
-        raise ScenarioError(
-            f"{key}.path_xz_m: empty; accepted: a list of [forward, up] waypoints, m"
+            "human.reactive.path_xz_m: empty; accepted: a list of [forward, up] waypoints, m"
         )
     previous = [0.0, 0.0]
-    for i, point in enumerate(r.path_xz_m):
+    for i, point in enumerate(reactive.path_xz_m):
         if math.dist(point, previous) < 1e-3:
             raise ScenarioError(
-                f"{key}.path_xz_m[{i}]: {point}; accepted: a waypoint at least 1 mm from "
-                f"the one before ({previous}; the path starts at [0, 0])"
+                f"human.reactive.path_xz_m[{i}]: {point}; accepted: a waypoint at least 1 mm "
+                f"from the one before ({previous}; the path starts at [0, 0])"
             )
         previous = point
-    if not r.lead_max_m >= r.lead_min_m:
+    if not reactive.lead_max_m >= reactive.lead_min_m:
         raise ScenarioError(
-            f"{key}.lead_max_m: {r.lead_max_m}; accepted: a number >= lead_min_m ({r.lead_min_m})"
+            f"human.reactive.lead_max_m: {reactive.lead_max_m}; accepted: a number >= "
+            f"lead_min_m ({reactive.lead_min_m})"
         )
+    return scenario

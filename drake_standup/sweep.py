@@ -18,7 +18,7 @@ import json
 import sys
 import time
 import traceback
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from drake_standup.cli import OneLineErrorParser
@@ -80,41 +80,22 @@ def run_sweep(
     out_dir = Path(out_dir)
     runs_dir = out_dir / "runs"
     runs_dir.mkdir(parents=True, exist_ok=True)
-    write_json(
-        out_dir / "sweep.json",
-        {
-            "name": spec.name,
-            "base": str(spec.base_path),
-            "seed": spec.seed,
-            "runs": [{"index": r.index, "run_id": r.run_id, "params": r.params} for r in runs],
-        },
-    )
-    records = {}
-    for run in runs:
-        path = runs_dir / f"{run.run_id}.json"
-        if path.is_file():
-            record = json.loads(path.read_text())
-            if not record.get("retry"):
-                records[run.run_id] = record
+    summary = {"name": spec.name, "base": str(spec.base_path), "seed": spec.seed}
+    summary["runs"] = [{"index": r.index, "run_id": r.run_id, "params": r.params} for r in runs]
+    write_json(out_dir / "sweep.json", summary)
+    # The runs saved by an earlier start, but for those the cluster lost (retried now).
+    saved = [runs_dir / f"{run.run_id}.json" for run in runs]
+    records = {path.stem: json.loads(path.read_text()) for path in saved if path.is_file()}
+    records = {run_id: r for run_id, r in records.items() if not r.get("retry")}
     todo = [r for r in runs if r.run_id not in records]
     if progress and records:
         print(f"resuming: {len(records)} of {len(runs)} runs already in {runs_dir}", flush=True)
 
     def on_result(run: RunSpec, metrics: dict | None, lost: BaseException | None) -> dict:
         if lost is not None:
-            text = " ".join(str(lost).split())
-            metrics = {
-                "success": False,
-                "failure_reason": f"cluster: {type(lost).__name__}: {text}"[:300],
-            }
-        record = {
-            "index": run.index,
-            "run_id": run.run_id,
-            "params": run.params,
-            "overrides": run.overrides,
-            "metrics": metrics,
-            "retry": lost is not None,
-        }
+            reason = f"cluster: {type(lost).__name__}: {' '.join(str(lost).split())}"
+            metrics = {"success": False, "failure_reason": reason[:300]}
+        record = {**asdict(run), "metrics": metrics, "retry": lost is not None}
         write_json(runs_dir / f"{run.run_id}.json", record)
         records[run.run_id] = record
         return metrics
@@ -165,12 +146,10 @@ def main(argv: list[str] | None = None, prog: str = "python -m drake_standup.swe
         "--limit", type=int, default=None, help="run only the first N runs of the sweep"
     )
     args = parser.parse_args(argv)
-    if args.workers < 1:
-        print(f"error: --workers: {args.workers}; accepted: an integer >= 1", file=sys.stderr)
-        return 2
-    if args.limit is not None and args.limit < 1:
-        print(f"error: --limit: {args.limit}; accepted: an integer >= 1", file=sys.stderr)
-        return 2
+    for flag, count in (("--workers", args.workers), ("--limit", args.limit)):
+        if count is not None and count < 1:
+            print(f"error: {flag}: {count}; accepted: an integer >= 1", file=sys.stderr)
+            return 2
     try:
         spec = load_sweep(args.spec)
     except SweepError as err:

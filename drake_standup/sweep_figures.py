@@ -42,24 +42,16 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
         for k, g in enumerate(groups):
             sel = [r for r in rows if fig.group is None or r.get(fig.group) == g]
             xs = sorted({r[fig.x] for r in sel}, key=_order)
-            mean = []
-            for x in xs:
-                ys = [_number(r.get(fig.y)) for r in sel if r[fig.x] == x and r.get("success")]
-                ys = [y for y in ys if y is not None]
-                mean.append(float(np.mean(ys)) if ys else np.nan)
+            stood = [(r[fig.x], _number(r.get(fig.y))) for r in sel if r.get("success")]
+            mean = [
+                np.mean([y for x, y in stood if x == at and y is not None] or [np.nan]) for at in xs
+            ]
             label = f"{fig.group} = {g}" if fig.group else None
             (line,) = ax.plot(xs, mean, marker=markers[k % len(markers)], label=label)
             # Failed runs: a cross at their value, or on the x axis without one.
-            failed = [r for r in sel if not r.get("success")]
+            failed = [(r[fig.x], _number(r.get(fig.y)) or 0.0) for r in sel if not r.get("success")]
             if failed:
-                ax.plot(
-                    [r[fig.x] for r in failed],
-                    [_number(r.get(fig.y)) or 0.0 for r in failed],
-                    "x",
-                    color=line.get_color(),
-                    ms=10,
-                    mew=2,
-                )
+                ax.plot(*zip(*failed), "x", color=line.get_color(), ms=10, mew=2)
         if fig.group:
             ax.legend(fontsize=8)
         ax.set_ylabel(fig.y)
@@ -76,16 +68,13 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
         low, high = fig.range or (xs.min(), xs.max())
         edges = np.linspace(low, high, fig.bins + 1)
         which = np.clip(np.digitize(xs, edges[1:-1]), 0, fig.bins - 1)
-        centres, rates, counts = [], [], []
-        for b in range(fig.bins):
-            sel = which == b
-            if sel.any():
-                centres.append(0.5 * (edges[b] + edges[b + 1]))
-                rates.append(ys[sel].mean())
-                counts.append(int(sel.sum()))
-        width = (edges[1] - edges[0]) * 0.9 if len(edges) > 1 else 1.0
+        counts = np.bincount(which, minlength=fig.bins)
+        filled = counts > 0  # empty bins get no bar
+        rates = np.bincount(which, weights=ys, minlength=fig.bins)[filled] / counts[filled]
+        centres = (0.5 * (edges[:-1] + edges[1:]))[filled]
+        width = 0.9 * (edges[1] - edges[0])
         ax.bar(centres, rates, width=width, color="tab:blue", alpha=0.7, edgecolor="tab:blue")
-        for c, r, n in zip(centres, rates, counts):
+        for c, r, n in zip(centres, rates, counts[filled]):
             ax.text(c, r + 0.02, f"n={n}", ha="center", fontsize=8)
         ax.set_ylim(0, 1.15)
         ax.set_ylabel(f"{fig.y} rate")

@@ -12,6 +12,7 @@ same loader, and the same checks, as a scenario file and `--set`.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import math
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ import numpy as np
 import yaml
 
 from drake_standup.config import (
+    Push,
     ScenarioError,
     apply_overrides,
     expand_key_path,
@@ -31,9 +33,6 @@ from drake_standup.resources import find, shipped
 
 class SweepError(ValueError):
     """A sweep file that cannot run; the message is one line naming the key."""
-
-
-DISTRIBUTIONS = ("uniform", "normal", "choice")
 
 
 @dataclass
@@ -81,13 +80,12 @@ class RunSpec:
     overrides: list  # [(concrete key path, value)], in order
 
 
-TOP_KEYS = ("name", "base", "seed", "samples", "overrides", "grid", "random")
-TOP_KEYS += ("perturbations", "figures")
+TOP_KEYS = tuple("name base seed samples overrides grid random perturbations figures".split())
 PERTURBATION_KEYS = ("push", "mass_scale", "friction_scale", "hand_wrench_noise_N")
-PUSH_KEYS = ("body", "start_s", "duration_s", "magnitude_N", "azimuth_deg", "elevation_deg")
-# What a push key left out of a sweep file means (config.Push's defaults).
-PUSH_DEFAULTS = {"start_s": 5.0, "duration_s": 0.2, "magnitude_N": 0.0}
-PUSH_DEFAULTS.update(azimuth_deg=0.0, elevation_deg=0.0)
+# A push's keys and what one left out of a sweep file means (config.Push's defaults).
+PUSH_DEFAULTS = {"body": Push.body, "start_s": Push.start_s, "duration_s": Push.duration_s}
+PUSH_DEFAULTS.update(magnitude_N=0.0, azimuth_deg=0.0, elevation_deg=0.0)
+DRAWS = "{uniform: [low, high]}, {normal: [mean, std]} or {choice: [a, b, ...]}"
 
 
 def load_sweep(path: str | Path) -> SweepSpec:
@@ -117,8 +115,17 @@ def load_sweep(path: str | Path) -> SweepSpec:
     overrides = raw.get("overrides") or {}
     if not isinstance(overrides, dict):
         raise SweepError("overrides: accepted: a mapping of key path -> value")
-    perturbations = raw.get("perturbations") or {}
-    _check_perturbations(perturbations)
+    perturbations = _known("perturbations", raw.get("perturbations") or {}, PERTURBATION_KEYS)
+    push = _known("perturbations.push", perturbations.get("push", {}), tuple(PUSH_DEFAULTS))
+    if not isinstance(push.get("body", ""), str):
+        raise SweepError("perturbations.push.body: accepted: the name of a robot body")
+    draws = {f"perturbations.push.{k}": v for k, v in push.items() if k != "body"}
+    draws.update({f"perturbations.{k}": v for k, v in perturbations.items() if k != "push"})
+    for where, draw in draws.items():
+        _check_draw(where, draw)
+    figures = raw.get("figures") or []
+    if not isinstance(figures, list):
+        raise SweepError(f"figures: {figures!r}; accepted: a list of {{kind, x, y, ...}}")
     spec = SweepSpec(
         name=str(raw.get("name", found.stem)),
         base_path=base_path,
@@ -126,12 +133,10 @@ def load_sweep(path: str | Path) -> SweepSpec:
         seed=_integer("seed", raw.get("seed", 0), 0),
         samples=_integer("samples", raw.get("samples", 1), 1),
         overrides=overrides,
-        grid=[_parameter(f"grid[{i}]", p, "values") for i, p in enumerate(_entries(raw, "grid"))],
-        random=[
-            _parameter(f"random[{i}]", p, "draw") for i, p in enumerate(_entries(raw, "random"))
-        ],
+        grid=_parameters(raw, "grid"),
+        random=_parameters(raw, "random"),
         perturbations=perturbations,
-        figures=[_figure(f"figures[{i}]", f) for i, f in enumerate(raw.get("figures") or [])],
+        figures=[_figure(f"figures[{i}]", f) for i, f in enumerate(figures)],
     )
     names = [p.name for p in spec.grid + spec.random]
     if len(set(names)) != len(names):
@@ -140,10 +145,14 @@ def load_sweep(path: str | Path) -> SweepSpec:
     return spec
 
 
-def _known(where: str, mapping: dict, accepted: tuple[str, ...]) -> None:
+def _known(where: str, mapping, accepted: tuple[str, ...]) -> dict:
+    """mapping, checked: a mapping of accepted keys only."""
+    if not isinstance(mapping, dict):
+        raise SweepError(f"{where}: accepted: a mapping of {', '.join(accepted)}")
     for key in mapping:
         if key not in accepted:
             raise SweepError(f"{where}.{key}: unknown key; accepted: {', '.join(accepted)}")
+    return mapping
 
 
 def _integer(where: str, value, low: int) -> int:
@@ -156,75 +165,52 @@ def _number(value) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-def _check_perturbations(perturbations) -> None:
-    if not isinstance(perturbations, dict):
-        raise SweepError(f"perturbations: accepted: a mapping of {', '.join(PERTURBATION_KEYS)}")
-    _known("perturbations", perturbations, PERTURBATION_KEYS)
-    if "push" in perturbations:
-        push = perturbations["push"]
-        if not isinstance(push, dict):
-            raise SweepError(f"perturbations.push: accepted: a mapping of {', '.join(PUSH_KEYS)}")
-        _known("perturbations.push", push, PUSH_KEYS)
-        for key in PUSH_KEYS[1:]:
-            _check_draw(f"perturbations.push.{key}", push.get(key, 0.0))
-        if not isinstance(push.get("body", "chest"), str):
-            raise SweepError("perturbations.push.body: accepted: the name of a robot body")
-    for key in PERTURBATION_KEYS[1:]:
-        if key in perturbations:
-            _check_draw(f"perturbations.{key}", perturbations[key])
-
-
-def _entries(raw: dict, key: str) -> list[dict]:
-    """grid/random as a list of entries; a mapping {path: values} is a shorthand."""
-    value = raw.get(key) or []
-    if isinstance(value, dict):
-        kind = "values" if key == "grid" else "draw"
-        return [{"path": path, kind: v} for path, v in value.items()]
-    if not isinstance(value, list) or not all(isinstance(e, dict) for e in value):
-        raise SweepError(f"{key}: accepted: a list of {{name, path(s), values}} or path: values")
-    return value
-
-
-def _parameter(where: str, entry: dict, kind: str) -> Parameter:
-    _known(where, entry, ("name", "path", "paths", kind))
-    paths = entry.get("paths", entry.get("path"))
-    paths = [paths] if isinstance(paths, str) else paths
-    if not paths or not all(isinstance(p, str) for p in paths):
-        raise SweepError(f"{where}.path: missing; accepted: a scenario key path or a list of them")
-    name = entry.get("name", paths[0])
-    if kind == "values":
-        values = entry.get("values")
-        if not isinstance(values, list) or not values:
-            raise SweepError(f"{where}.values: {values!r}; accepted: a non-empty list")
-        return Parameter(name, paths, values=values)
-    _check_draw(f"{where}.draw", entry.get("draw"), constant_ok=False)
-    return Parameter(name, paths, draw=entry["draw"])
+def _parameters(raw: dict, key: str) -> list[Parameter]:
+    """grid or random: a list of {name, path or paths, values or draw}; a mapping
+    {path: values or draw} is a shorthand."""
+    kind = "values" if key == "grid" else "draw"
+    entries = raw.get(key) or []
+    if isinstance(entries, dict):
+        entries = [{"path": path, kind: value} for path, value in entries.items()]
+    if not isinstance(entries, list):
+        raise SweepError(f"{key}: accepted: a list of {{name, path(s), {kind}}} or path: {kind}")
+    params = []
+    for i, entry in enumerate(entries):
+        where = f"{key}[{i}]"
+        _known(where, entry, ("name", "path", "paths", kind))
+        paths = entry.get("paths", entry.get("path"))
+        paths = [paths] if isinstance(paths, str) else paths
+        if not paths or not isinstance(paths, list) or not all(isinstance(p, str) for p in paths):
+            raise SweepError(
+                f"{where}.path: missing; accepted: a scenario key path or a list of them"
+            )
+        value = entry.get(kind)
+        if kind == "values" and not (isinstance(value, list) and value):
+            raise SweepError(f"{where}.values: {value!r}; accepted: a non-empty list")
+        if kind == "draw":
+            _check_draw(f"{where}.draw", value, constant_ok=False)
+        params.append(Parameter(entry.get("name", paths[0]), paths, **{kind: value}))
+    return params
 
 
 def _check_draw(where: str, draw, constant_ok: bool = True) -> None:
-    if constant_ok and isinstance(draw, int | float | str) and not isinstance(draw, bool):
-        return
-    ok = isinstance(draw, dict) and len(draw) == 1 and next(iter(draw)) in DISTRIBUTIONS
-    if ok:
-        ((kind, args),) = draw.items()
-        ok = isinstance(args, list) and len(args) > 0
-        if kind != "choice":
-            ok = ok and len(args) == 2 and all(_number(a) for a in args)
-            ok = ok and (args[0] <= args[1] if kind == "uniform" else args[1] >= 0)
+    """A distribution (DRAWS) or, where constant_ok, a number or a name."""
+    one = isinstance(draw, dict) and len(draw) == 1
+    kind, args = next(iter(draw.items())) if one else (None, None)
+    two_numbers = isinstance(args, list) and len(args) == 2 and all(map(_number, args))
+    ok = {
+        "uniform": two_numbers and args[0] <= args[1],
+        "normal": two_numbers and args[1] >= 0,
+        "choice": isinstance(args, list) and len(args) > 0,
+    }.get(kind, constant_ok and (_number(draw) or isinstance(draw, str)))
     if not ok:
         accepted = "a number, " if constant_ok else ""
-        raise SweepError(
-            f"{where}: {draw!r}; accepted: {accepted}{{uniform: [low, high]}}, "
-            "{normal: [mean, std]} or {choice: [a, b, ...]}"
-        )
+        raise SweepError(f"{where}: {draw!r}; accepted: {accepted}{DRAWS}")
 
 
 def _figure(where: str, entry) -> Figure:
-    if not isinstance(entry, dict):
-        raise SweepError(f"{where}: accepted: a mapping of kind, x, y, group, bins, title")
-    _known(where, entry, tuple(Figure.__dataclass_fields__))
-    figure = Figure(**entry)
-    lines = figure.lines
+    figure = Figure(**_known(where, entry, tuple(Figure.__dataclass_fields__)))
+    lines, span = figure.lines, figure.range
     if not isinstance(lines, list) or not all(
         isinstance(line, dict)
         and set(line) == {"x", "label"}
@@ -235,7 +221,6 @@ def _figure(where: str, entry) -> Figure:
         raise SweepError(
             f"{where}.lines: {lines!r}; accepted: a list of {{x: number, label: text}}"
         )
-    span = figure.range
     if span is not None and not (
         isinstance(span, list) and len(span) == 2 and all(map(_number, span)) and span[0] < span[1]
     ):
@@ -277,39 +262,30 @@ def expand(spec: SweepSpec) -> list[RunSpec]:
     """Grid x samples runs; run k's draws come from the generator seeded by
     (seed, k), so a run's parameters don't depend on the others. Checks every
     key path and value against the base scenario (raises SweepError)."""
-    try:
-        base = parse_scenario(spec.base_text, str(spec.base_path))
-    except ScenarioError as err:
-        raise SweepError(f"base: {err}") from None
-    fixed = []
-    for path, value in spec.overrides.items():
-        fixed += [(p, value) for p in _expand_path(base, path, f"overrides.{path}")]
-    base = _apply(base, fixed, "overrides")
-    grid_paths = {
-        param.name: [p for path in param.paths for p in _expand_path(base, path, param.name)]
-        for param in spec.grid + spec.random
+    base = _checked("base", parse_scenario, spec.base_text, str(spec.base_path))
+    fixed = [
+        (concrete, value)
+        for path, value in spec.overrides.items()
+        for concrete in _paths(base, path, f"overrides.{path}")
+    ]
+    base = _checked("overrides", apply_overrides, base, fixed)
+    # Column name -> the concrete key paths it sets, in the order the overrides are applied.
+    paths = {
+        p.name: [c for path in p.paths for c in _paths(base, path, p.name)]
+        for p in spec.grid + spec.random
     }
-    combos = [{}]
-    for param in spec.grid:
-        combos = [{**c, param.name: v} for c in combos for v in param.values]
+    names = [param.name for param in spec.grid]
+    combos = [dict(zip(names, v)) for v in itertools.product(*(p.values for p in spec.grid))]
     runs = []
-    for combo in combos:
-        for _ in range(spec.samples):
-            index = len(runs)
-            rng = np.random.default_rng([spec.seed, index])
-            params = dict(combo)
-            for param in spec.random:
-                params[param.name] = _draw(rng, param.draw)
-            overrides = []
-            for param in spec.grid + spec.random:
-                overrides += [(p, params[param.name]) for p in grid_paths[param.name]]
-            overrides += _perturbations(rng, spec.perturbations, params)
-            _apply(base, overrides, f"run {index} ({params})")
-            runs.append(
-                RunSpec(
-                    index, _run_id(spec.base_text, fixed + overrides), params, fixed + overrides
-                )
-            )
+    for index, combo in enumerate([c for c in combos for _ in range(spec.samples)]):
+        rng = np.random.default_rng([spec.seed, index])
+        params = {**combo, **{param.name: _draw(rng, param.draw) for param in spec.random}}
+        overrides = fixed + [
+            (c, params[name]) for name, concrete in paths.items() for c in concrete
+        ]
+        overrides += _perturbations(rng, spec.perturbations, params)
+        _checked(f"run {index} ({params})", apply_overrides, base, overrides)
+        runs.append(RunSpec(index, _run_id(spec.base_text, overrides), params, overrides))
     return runs
 
 
@@ -317,9 +293,9 @@ def _perturbations(rng: np.random.Generator, pert: dict, params: dict) -> list:
     """One run's draws of the perturbations: overrides, and their columns in params."""
     overrides = []
     if "push" in pert:
-        push = pert["push"]
+        push = {**PUSH_DEFAULTS, **pert["push"]}
         start, duration, magnitude, azimuth, elevation = (
-            _draw(rng, push.get(k, PUSH_DEFAULTS[k])) for k in PUSH_KEYS[1:]
+            _draw(rng, push[k]) for k in list(PUSH_DEFAULTS)[1:]
         )
         az, el = math.radians(azimuth), math.radians(elevation)
         force = [
@@ -335,8 +311,7 @@ def _perturbations(rng: np.random.Generator, pert: dict, params: dict) -> list:
             push_azimuth_deg=azimuth,
             push_elevation_deg=elevation,
         )
-        body = push.get("body", "chest")
-        pushed = {"body": body, "start_s": start, "duration_s": duration, "force_N": force}
+        pushed = {"body": push["body"], "start_s": start, "duration_s": duration, "force_N": force}
         overrides.append(("perturbation.pushes", [] if magnitude == 0 else [pushed]))
     for key in PERTURBATION_KEYS[1:]:
         if key in pert:
@@ -347,18 +322,17 @@ def _perturbations(rng: np.random.Generator, pert: dict, params: dict) -> list:
     return overrides
 
 
-def _expand_path(base, path: str, where: str) -> list[str]:
-    try:
-        paths = expand_key_path(base, path)
-    except ScenarioError as err:
-        raise SweepError(f"{where}: {err}") from None
+def _paths(base, path: str, where: str) -> list[str]:
+    """The concrete key paths of path ([*]: every entry) in the base scenario."""
+    paths = expand_key_path(base, path)
     if not paths:
         raise SweepError(f"{where}: key path '{path}' names no key of the base scenario")
     return paths
 
 
-def _apply(scenario, overrides: list, where: str):
+def _checked(where: str, function, *args):
+    """function(*args); a ScenarioError becomes a SweepError naming where."""
     try:
-        return apply_overrides(scenario, overrides)
+        return function(*args)
     except ScenarioError as err:
         raise SweepError(f"{where}: {err}") from None

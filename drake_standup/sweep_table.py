@@ -8,59 +8,47 @@ import csv
 import math
 from pathlib import Path
 
-HEAD_METRICS = (
-    "success",
-    "failure_reason",
-    "standup_time_s",
-    "psi_final",
-    "psi_dot_max",
-    "com_tracking_rms_m",
-    "max_abs_torque_Nm",
-    "qp_failures",
-    "sim_time_s",
-    "wall_time_s",
-    "run_wall_s",
+# The metrics a reader looks at first, right after the parameters.
+HEAD_METRICS = tuple(
+    "success failure_reason standup_time_s psi_final psi_dot_max com_tracking_rms_m "
+    "max_abs_torque_Nm qp_failures sim_time_s wall_time_s run_wall_s".split()
 )
+# Columns that measure the machine, not the simulation.
+TIMING_COLUMNS = ("wall_time_s", "run_wall_s", "realtime_factor", "build_time_s")
 
 
-def flatten(prefix: str, value, out: dict) -> None:
+def flatten(value, prefix: str = "") -> dict:
     """Nested metrics -> columns: 'a.b' for mappings, 'a[i]' for lists."""
     if isinstance(value, dict):
-        for key, item in value.items():
-            flatten(f"{prefix}.{key}" if prefix else key, item, out)
-    elif isinstance(value, (list, tuple)):
-        for i, item in enumerate(value):
-            flatten(f"{prefix}[{i}]", item, out)
+        items = [(f"{prefix}.{key}" if prefix else key, item) for key, item in value.items()]
+    elif isinstance(value, list | tuple):
+        items = [(f"{prefix}[{i}]", item) for i, item in enumerate(value)]
     else:
-        out[prefix] = value
+        return {prefix: value}
+    return {column: leaf for key, item in items for column, leaf in flatten(item, key).items()}
 
 
 def table_rows(records: list[dict]) -> list[dict]:
-    rows = []
-    for record in records:
-        row = {"index": record["index"], "run_id": record["run_id"]}
-        flatten("", record["params"], row)
-        metrics: dict = {}
-        flatten("", record["metrics"], metrics)
-        row.update(metrics)
-        rows.append(row)
-    return rows
+    """A row per run: index, run_id, its parameters and its metrics, flattened."""
+    return [
+        {
+            "index": r["index"],
+            "run_id": r["run_id"],
+            **flatten(r["params"]),
+            **flatten(r["metrics"]),
+        }
+        for r in records
+    ]
 
 
 def write_table(path: Path, records: list[dict], param_names: list[str]) -> None:
     """One tidy CSV: a row per run; index, run_id, the parameters, the metrics."""
     rows = table_rows(records)
-    params: list[str] = []
-    for record in records:
-        flat: dict = {}
-        flatten("", record["params"], flat)
-        params += [k for k in flat if k not in params]
+    params = list(dict.fromkeys(key for r in records for key in flatten(r["params"])))
     params.sort(key=lambda k: param_names.index(k) if k in param_names else len(param_names))
     metrics = [m for m in HEAD_METRICS if any(m in row for row in rows)]
-    for row in rows:
-        metrics += [
-            k for k in row if k not in metrics and k not in params and k not in ("index", "run_id")
-        ]
+    seen = {"index", "run_id", *params, *metrics}
+    metrics += [k for k in dict.fromkeys(k for row in rows for k in row) if k not in seen]
     columns = ["index", "run_id"] + params + metrics
     with path.open("w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=columns)
@@ -70,15 +58,9 @@ def write_table(path: Path, records: list[dict], param_names: list[str]) -> None
 
 
 def _cell(value):
-    if value is None:
-        return ""
-    if isinstance(value, float) and not math.isfinite(value):
-        return ""
-    return value
-
-
-# Columns that measure the machine, not the simulation.
-TIMING_COLUMNS = ("wall_time_s", "run_wall_s", "realtime_factor", "build_time_s")
+    """None and non-finite numbers as empty cells."""
+    finite = not isinstance(value, float) or math.isfinite(value)
+    return value if value is not None and finite else ""
 
 
 def simulation_rows(path: Path) -> list[dict]:
@@ -91,18 +73,12 @@ def read_table(path: Path) -> list[dict]:
     """results.csv back as dicts of numbers, booleans and strings."""
 
     def parse(text: str):
-        if text == "":
-            return None
-        if text in ("True", "False"):
-            return text == "True"
-        try:
-            return int(text)
-        except ValueError:
-            pass
-        try:
-            return float(text)
-        except ValueError:
-            return text
+        for number in (int, float):
+            try:
+                return number(text)
+            except ValueError:
+                pass
+        return {"": None, "True": True, "False": False}.get(text, text)
 
     with Path(path).open(newline="") as f:
         return [{k: parse(v) for k, v in row.items()} for row in csv.DictReader(f)]
