@@ -16,6 +16,7 @@ from pathlib import Path
 # Command -> (module with main(argv, prog), one line of help).
 COMMANDS = {
     "run": ("drake_standup.cli", "simulate one scenario: recording, metrics, figures"),
+    "live": ("drake_standup.cli", "be the helper: run paced at real time, pull from the page"),
     "sweep": ("drake_standup.sweep", "many runs on Dask: a grid, random draws, perturbations"),
     "bench": ("drake_standup.bench", "how fast the stand-up simulates, and where time goes"),
     "convergence": ("drake_standup.convergence", "the plant-step convergence study"),
@@ -49,6 +50,8 @@ def main(argv: list[str] | None = None) -> int:
     prog = f"drake-standup {name}"
     if name == "run":
         return run_main(rest, prog)
+    if name == "live":  # run --live
+        return run_main(["--live", *rest], prog)
     if name == "scenarios":
         return scenarios_main(rest, prog)
     return importlib.import_module(COMMANDS[name][0]).main(rest, prog=prog)
@@ -63,8 +66,12 @@ def run_parser(prog: str) -> OneLineErrorParser:
         prog=prog,
         description="Simulate the iCub stand-up scenario and write recording, metrics, "
         "figures and diagram.",
-        epilog="example:\n  drake-standup run --scenario unassisted --set "
-        "advancement.psi_dot_upper=2.0 --duration 4 --no-recording --out out/try",
+        epilog=(
+            "example:\n  drake-standup live --scenario unassisted --duration 60 --out out/me"
+            if prog.endswith(" live")
+            else "example:\n  drake-standup run --scenario unassisted --set "
+            "advancement.psi_dot_upper=2.0 --duration 4 --no-recording --out out/try"
+        ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(

@@ -102,6 +102,7 @@ BAD = {
     "unknown_sweep": (ARGS, ["sweep", "nosuch"], "'nosuch' not found"),
     "zero_workers": (ARGS, ["sweep", "assistance", "--workers", "0"], "--workers"),
     "unknown_command": (ARGS, ["fly"], "'fly': unknown command"),
+    "live_without_meshcat": (ARGS, ["live", "--no-recording"], "--no-recording"),
 }
 
 
