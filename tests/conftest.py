@@ -16,3 +16,42 @@ def seated_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("seated")
     result = simulate(scenario, out, record=True, progress=False)
     return scenario, result, out
+
+
+@pytest.fixture
+def limp_robot_rig():
+    """A factory: make_human(plant, robot, dt) -> a human source, wired to a floating,
+    limp iCub (zero torques) with no gravity and no contact, 3 m up; returns
+    (simulator, plant, plant_context). The human sources' momentum tests share it."""
+    import numpy as np
+    from pydrake.math import RigidTransform
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    from drake_standup.robot import ContactModel, add_icub
+
+    def build(make_human, dt: float = 1e-3):
+        builder = DiagramBuilder()
+        plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=dt)
+        robot = add_icub(plant, visuals=False, contact=ContactModel())
+        plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
+        plant.Finalize()
+        human = builder.AddSystem(make_human(plant, robot, dt))
+        builder.Connect(
+            human.GetOutputPort("spatial_forces"), plant.get_applied_spatial_force_input_port()
+        )
+        builder.Connect(
+            plant.get_state_output_port(robot.model_instance), human.GetInputPort("robot_state")
+        )
+        zero = builder.AddSystem(ConstantVectorSource(np.zeros(plant.num_actuated_dofs())))
+        builder.Connect(zero.get_output_port(), plant.get_actuation_input_port())
+        simulator = Simulator(builder.Build())
+        plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
+        plant.SetFreeBodyPose(
+            plant_context, plant.GetBodyByName("root_link"), RigidTransform([0, 0, 3])
+        )
+        return simulator, plant, plant_context
+
+    return build

@@ -9,11 +9,6 @@ import math
 
 import numpy as np
 import pytest
-from pydrake.math import RigidTransform
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import ConstantVectorSource
 
 from drake_standup.config import (
     SCENARIO_DIR,
@@ -27,7 +22,6 @@ from drake_standup.config import (
 )
 from drake_standup.diagram import build_diagram
 from drake_standup.human import HumanWrenchSource, Path, path_force, reactive_force, trapezoid
-from drake_standup.robot import ContactModel, add_icub
 
 PULLS = [
     Pull(hand="left", start_s=1.0, duration_s=2.0, ramp_s=0.5, force_N=[20.0, 0.0, 10.0]),
@@ -83,32 +77,14 @@ def test_plant_receives_exactly_the_scripted_force():
         np.testing.assert_allclose(w.reshape(2, 6)[:, 3:], _expected(t), atol=1e-12)
 
 
-def test_pulls_change_linear_momentum_by_their_impulse():
+def test_pulls_change_linear_momentum_by_their_impulse(limp_robot_rig):
     """Zero gravity, no contact, a limp floating robot: its linear momentum
     changes by the pulls' impulse sum F(t_n) dt (Newton's second law). The
     discrete plant updates velocities with the mass matrix of the step's start
     while the limp robot spins, an O(dt) error: 0.6% at 1 ms, hence 1%; a
     wrong hand, sign, body or ramp is off by far more."""
-    builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=1e-3)
-    robot = add_icub(plant, visuals=False, contact=ContactModel())
-    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
-    plant.Finalize()
-    human = builder.AddSystem(HumanWrenchSource(plant, robot, HumanConfig(pulls=PULLS)))
-    builder.Connect(
-        human.GetOutputPort("spatial_forces"), plant.get_applied_spatial_force_input_port()
-    )
-    builder.Connect(
-        plant.get_state_output_port(robot.model_instance), human.GetInputPort("robot_state")
-    )
-    zero = builder.AddSystem(ConstantVectorSource(np.zeros(plant.num_actuated_dofs())))
-    builder.Connect(zero.get_output_port(), plant.get_actuation_input_port())
-    diagram = builder.Build()
-    simulator = Simulator(diagram)
-    root = simulator.get_mutable_context()
-    plant_context = plant.GetMyMutableContextFromRoot(root)
-    plant.SetFreeBodyPose(
-        plant_context, plant.GetBodyByName("root_link"), RigidTransform([0, 0, 3])
+    simulator, plant, plant_context = limp_robot_rig(
+        lambda plant, robot, dt: HumanWrenchSource(plant, robot, HumanConfig(pulls=PULLS))
     )
     mass = plant.CalcTotalMass(plant_context)
     t_end = 3.5

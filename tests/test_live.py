@@ -12,11 +12,7 @@ from pathlib import Path
 import msgpack
 import numpy as np
 import pytest
-from pydrake.math import RigidTransform
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
-from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import ConstantVectorSource
 
 from drake_standup.config import SCENARIO_DIR, HumanConfig, Scenario, load_scenario
 from drake_standup.diagram import build_diagram
@@ -32,7 +28,6 @@ from drake_standup.live import (
     gamepad_pull,
     make_live_meshcat,
 )
-from drake_standup.robot import ContactModel, add_icub
 from drake_standup.scene import set_seated_state
 from drake_standup.simulate import simulate
 
@@ -151,33 +146,17 @@ def test_sliders_reach_the_plant_and_the_hand_wrenches_within_one_step():
     np.testing.assert_array_equal(live.measured(), [_world((cap, -cap))] * 2)
 
 
-def test_a_slider_pull_changes_momentum_by_its_impulse():
+def test_a_slider_pull_changes_momentum_by_its_impulse(limp_robot_rig):
     """Zero gravity, no contact, a limp floating robot pulled from the sliders: its
     linear momentum grows by F (T - dt) (Newton's second law; the first step still
     sees the pull of before the update). As in test_human's scripted twin, within
     1%: the limp robot's joints settle onto their limits in the first steps, a
     transient of ~0.2 N s in the discrete plant's momentum (the same with the
     scripted human), small against 2 s of pull."""
-    builder = DiagramBuilder()
     dt = 1e-3
-    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=dt)
-    robot = add_icub(plant, visuals=False, contact=ContactModel())
-    plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
-    plant.Finalize()
     meshcat = make_live_meshcat()
-    human = builder.AddSystem(LiveHumanSource(plant, robot, HumanConfig(), meshcat, dt))
-    builder.Connect(
-        human.GetOutputPort("spatial_forces"), plant.get_applied_spatial_force_input_port()
-    )
-    builder.Connect(
-        plant.get_state_output_port(robot.model_instance), human.GetInputPort("robot_state")
-    )
-    zero = builder.AddSystem(ConstantVectorSource(np.zeros(plant.num_actuated_dofs())))
-    builder.Connect(zero.get_output_port(), plant.get_actuation_input_port())
-    simulator = Simulator(builder.Build())
-    plant_context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
-    plant.SetFreeBodyPose(
-        plant_context, plant.GetBodyByName("root_link"), RigidTransform([0, 0, 3])
+    simulator, plant, plant_context = limp_robot_rig(
+        lambda plant, robot, dt: LiveHumanSource(plant, robot, HumanConfig(), meshcat, dt), dt
     )
     _set_pull(meshcat, (10.0, 5.0), (10.0, 5.0))
     t_end = 2.0
