@@ -27,6 +27,13 @@ and triggers live in the mode: next_mode stays a pure function.
 The contact plan says what is left of each seat pad's load while it unloads
 (NaN while seated): the buttocks from 1 to 0 over seat_unload_s from state 2,
 each thigh over seat_release_s from state 3 (smoothstep in both).
+
+A pull against the stand-up (both hands together pulled backwards by more than
+hindering_force_threshold_N, through the same filter and trigger) waits: state 1
+does not start; state 2, and state 3 while the thighs carry more than
+reseat_above_thigh_load of their load, sit back into state 1 (_reseat: the
+reference returns to the seated CoM); later state 3 holds. The stand-up goes on
+resume_after_s after the pull stops.
 """
 
 from __future__ import annotations
