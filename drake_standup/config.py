@@ -224,7 +224,8 @@ class StandupConfig:
     # guards' hysteresis and dwell): the stand-up waits. Seated it does not start;
     # in state 2, or in state 3 while the thighs still carry most of their load
     # (reseat_above_thigh_load), it sits back into state 1; later in state 3 it
-    # holds. psi = t meanwhile (the pull does not help). Issue 13: 10 N backwards
+    # goes back onto the thighs (state 2) while they unload, and holds once they
+    # are off. psi = t meanwhile (the pull does not help). Issue 13: 10 N backwards
     # per hand toppled the robot over the chair; in state 2 so did 2 N per hand
     # (4 N together, under the first threshold of 8 N), while 1 N per hand stood
     # up (measured). N.
@@ -233,12 +234,13 @@ class StandupConfig:
     # (re)starts from state 1 or goes on from state 3: the pull is over, not
     # paused, and the arms it swung back return to their posture first. s.
     resume_after_s: float = 0.5
-    # In state 3 a hindering pull sits the robot back while the thighs' release
-    # has left them more than this fraction of their load (the plan's smoothstep);
-    # later state 3 holds. Sat back with the thighs at 0.4 or 0.7 of their load,
-    # the robot sat further forward on the chair and its next attempt fell back;
-    # holding there, it stood. With the thighs at 0.95 sitting back worked, holding
-    # fell (measured, 15 N per hand).
+    # In state 3 a hindering pull sits the robot back into state 1 while the
+    # thighs' release has left them more than this fraction of their load (the
+    # plan's smoothstep); below it, the thighs still unloading, it goes back onto
+    # them in state 2 and waits there. Sat back with the thighs at 0.7 or 0.4 of
+    # their load the robot ended up further forward on the chair and its next
+    # attempt fell back; held in state 3 at 0.7-0.9, the thighs unloaded under the
+    # pull and it tipped back (measured, 15 N per hand).
     reseat_above_thigh_load: float = 0.9
     # Min-jerk segment lengths of states 2, 3, 4 in units of psi (= s when
     # psi = t); the advancement version's [1.5, 0.5, 1.8] (SPEC 3).

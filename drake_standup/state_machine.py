@@ -32,8 +32,10 @@ A pull against the stand-up (both hands together pulled backwards by more than
 hindering_force_threshold_N, through the same filter and trigger) waits: state 1
 does not start; state 2, and state 3 while the thighs carry more than
 reseat_above_thigh_load of their load, sit back into state 1 (_reseat: the
-reference returns to the seated CoM); later state 3 holds. The stand-up goes on
-resume_after_s after the pull stops.
+reference returns to the seated CoM); later in state 3, the thighs unloading, the
+robot goes back onto them in state 2 (_back_to_state_2: the reference held); once
+they are off the chair state 3 holds. The stand-up goes on resume_after_s after
+the pull stops.
 """
 
 from __future__ import annotations
@@ -106,6 +108,9 @@ class StandupMode:
     # there, so that its next state-2 segment starts where the first one did.
     x_seated_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     hindered_until_s: float = -math.inf  # the last time a hindering pull was felt
+    # State 3 sent back to state 2 by a hindering pull: where its segment was to end
+    # (NaN: not sent back). The next state 3 ends there.
+    state3_end_m: tuple[float, float, float] = (math.nan, math.nan, math.nan)
 
     def __copy__(self) -> StandupMode:
         return self
@@ -191,11 +196,13 @@ def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> Standup
     segment_done = m.psi - mode.psi_entry >= mode.segment_psi
     hindered = g.hindered.on
     calm = not hindered and m.t - mode.hindered_until_s >= cfg.resume_after_s
-    if hindered and (
-        mode.state == 2
-        or (mode.state == 3 and seat_unloading(mode, m.t, cfg)[1] > cfg.reseat_above_thigh_load)
-    ):
-        # The thighs still on the chair: sit back and wait.
+    if hindered and mode.state == 3:
+        thighs = seat_unloading(mode, m.t, cfg)[1]
+        if thighs > cfg.reseat_above_thigh_load:  # the thighs still carry the robot
+            return _reseat(mode, m, cfg)
+        if thighs > 0.0:  # the thighs unloading: back onto them
+            return _back_to_state_2(mode, m)
+    if hindered and mode.state == 2 and math.isnan(mode.state3_end_m[0]):
         return _reseat(mode, m, cfg)
     if mode.state == 1:
         asked = cfg.trigger == "time" or g.hands_pulled.on or m.stand_up
@@ -207,6 +214,7 @@ def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> Standup
             and segment_done
             and g.feet_loaded.on
             and m.com_W[0] >= m.heel_x + cfg.com_ahead_of_heels_m
+            and calm
         )
     elif mode.state == 3:
         go = (
@@ -242,6 +250,31 @@ def _reseat(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> StandupMo
         segment_psi=cfg.segment_psi[0],
         x_start_m=tuple(float(v) for v in x_now),
         delta_m=tuple(float(a - b) for a, b in zip(mode.x_seated_m, x_now, strict=True)),
+        state3_end_m=(math.nan, math.nan, math.nan),
+    )
+
+
+def _back_to_state_2(mode: StandupMode, m: Measurements) -> StandupMode:
+    """From state 3, the thighs unloading, back to state 2 under a hindering pull: the
+    thighs are planned seated again (they carry what the chair gives) and the reference
+    stops where the state-3 segment had brought it (psi = t, nothing advances). Once the
+    pull has stopped, state 2's guards (calm among them) go on to state 3 again, whose
+    segment then ends where the interrupted one would have. Holding state 3 instead, the
+    thighs went on unloading under the pull and a 15 N per hand pull caught with them at
+    70-90 % of their load tipped the robot back; sat back into state 1 from there, it
+    ended up further forward on the chair and its next attempt fell back (measured)."""
+    x_now = path(mode.segment(), m.psi)[0]
+    entry = list(mode.entry_times_s)
+    entry[2] = math.nan
+    return dataclasses.replace(
+        mode,
+        state=2,
+        entry_times_s=tuple(entry),
+        psi_entry=m.psi,
+        segment_psi=1.0,
+        x_start_m=tuple(float(v) for v in x_now),
+        delta_m=(0.0, 0.0, 0.0),
+        state3_end_m=tuple(float(v) for v in mode.segment_end()),
     )
 
 
@@ -261,6 +294,8 @@ def _enter(mode: StandupMode, state: int, m: Measurements, cfg: StandupConfig) -
         delta = np.array(cfg.state2_com_delta_m)
     elif state == 3:
         delta = np.array(cfg.state3_com_delta_m)
+        if not math.isnan(mode.state3_end_m[0]):  # once more, after a hindering pull
+            delta[:2] = np.array(mode.state3_end_m[:2]) - x_start[:2]
     else:
         delta = np.array([0.0, 0.0, cfg.standing_com_height_m - x_start[2]])
     entry = list(mode.entry_times_s)
@@ -273,6 +308,7 @@ def _enter(mode: StandupMode, state: int, m: Measurements, cfg: StandupConfig) -
         segment_psi=cfg.segment_psi[state - 2],
         x_start_m=tuple(float(v) for v in x_start),
         delta_m=tuple(float(v) for v in delta),
+        state3_end_m=(math.nan, math.nan, math.nan),
     )
 
 

@@ -122,12 +122,21 @@ def test_a_hindering_pull_waits_seated_and_the_robot_stands_up_once_it_stops():
 
 @pytest.mark.parametrize(
     ("start_s", "force_N"),
-    [(1.0, 15.0), (3.5, 15.0), (4.6, 15.0), (5.2, 15.0), (8.0, 15.0), (3.2, 2.0)],
-    ids=["seated", "in_state_2", "in_state_3", "in_state_4", "standing", "2N_in_state_2"],
+    [(1.0, 15.0), (3.5, 15.0), (4.5, 15.0), (4.6, 15.0), (5.2, 15.0), (8.0, 15.0), (3.2, 2.0)],
+    ids=[
+        "seated",
+        "in_state_2",
+        "as_state_3_begins",
+        "in_state_3",
+        "in_state_4",
+        "standing",
+        "2N_in_state_2",
+    ],
 )
 def test_a_hindering_pull_in_any_state_does_not_topple_it(start_s, force_N):
     """Issue 13: 15 N backwards on each hand for 4 s, started before the stand-up (1.0 s),
-    inside state 2 (3.5 s: it sits back and waits), state 3 (4.6 s: it holds there),
+    inside state 2 (3.5 s: it sits back and waits), as state 3 begins (4.5 s) or inside
+    it (4.6 s: it goes back onto its thighs in state 2),
     state 4 (5.2 s) or on the standing robot (8.0 s: it leans into the pull within its
     feet). No fall, psi = t throughout, and it ends standing erect (before the lean was
     bounded by the feet it fell when the pull stopped). 2 N per hand in state 2 toppled

@@ -335,14 +335,46 @@ def test_a_backward_pull_with_the_thighs_on_the_chair_sits_back_without_a_jump(s
     np.testing.assert_allclose(again.x_start_m, COM0, atol=1e-12)
 
 
-@pytest.mark.parametrize("into_release", [0.25, 1.01])
-def test_state_3_holds_once_the_thighs_have_begun_to_unload(into_release):
-    """A quarter into the thighs' release (they carry 84 % of their load, smoothstep:
-    below reseat_above_thigh_load) or after it, a backward pull no longer sits the
-    robot back: state 3 holds."""
+@pytest.mark.parametrize("into_release", [0.25, 0.6])
+def test_state_3_goes_back_onto_the_thighs_while_they_unload(into_release):
+    """A quarter or 0.6 into the thighs' release (they carry 84 % or 35 % of their load,
+    smoothstep: below reseat_above_thigh_load) a backward pull sends state 3 back to
+    state 2, the reference held where the state-3 segment had brought it (the path
+    evaluated independently here) and the thighs planned seated; it stays there while
+    pulled, however the guards read; once the pull has stopped for resume_after_s, state
+    3 again, whose segment ends where the interrupted one was to end."""
     cfg = dataclasses.replace(CFG, trigger="time")
     mode = _in_state(3, 5.0, cfg)
-    t = 5.0 + into_release * cfg.seat_release_s
+    end = mode.segment_end()
+    t = psi = 5.0 + into_release * cfg.seat_release_s
+    back = (-10.0, -10.0)
+    feet = (500.0, 500.0)
+    held = _next(mode, _m(t, psi=psi, feet=feet, hands=back), cfg)
+    assert held.state == 2 and math.isnan(held.entry_times_s[2])
+    tau = min((psi - mode.psi_entry) / mode.segment_psi, 1.0)
+    s = 10 * tau**3 - 15 * tau**4 + 6 * tau**5
+    x_held = np.array(mode.x_start_m) + s * np.array(mode.delta_m)
+    np.testing.assert_allclose(held.x_start_m, x_held, atol=1e-12)
+    assert held.delta_m == (0.0, 0.0, 0.0)
+    assert math.isnan(seat_unloading(held, t, cfg)[1])  # the thighs seated again
+    later = t + 5.0  # still pulled: feet loaded, CoM ahead, segment done; still state 2
+    assert _next(held, _m(later, psi=later, feet=feet, hands=back), cfg).state == 2
+    held = dataclasses.replace(held, hindered_until_s=later)
+    calm = (0.0, 0.0)
+    soon = later + 0.9 * cfg.resume_after_s
+    assert _next(held, _m(soon, psi=soon, feet=feet, hands=calm), cfg).state == 2
+    go = later + cfg.resume_after_s + 0.01
+    again = _next(held, _m(go, psi=go, feet=feet, hands=calm), cfg)
+    assert again.state == 3
+    np.testing.assert_allclose(again.segment_end()[:2], end[:2], atol=1e-12)
+
+
+def test_state_3_holds_once_the_thighs_are_off_the_chair():
+    """After the thighs' release a backward pull no longer takes the robot back: state 3
+    holds."""
+    cfg = dataclasses.replace(CFG, trigger="time")
+    mode = _in_state(3, 5.0, cfg)
+    t = 5.0 + 1.01 * cfg.seat_release_s
     feet = (500.0, 500.0)
     held = _next(mode, _m(t, feet=feet, hands=(-10.0, -10.0)), cfg)
     assert held.state == 3 and held.x_start_m == mode.x_start_m
