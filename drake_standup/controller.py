@@ -64,7 +64,7 @@ from drake_standup.control.tasks import (
     PostureTask,
     StancePostureTask,
 )
-from drake_standup.control.terms import BASE_BODY, RobotKinematics, RobotTerms
+from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.robot import Robot, actuated_joints
 
 _POSTURE_JOINTS = (
@@ -328,14 +328,9 @@ class _Joints:
     v_indices: np.ndarray  # index of each joint's rate in v
     q_min: np.ndarray  # position limits, rad
     q_max: np.ndarray
-    # True for a joint that moves none of the held frames (but the base): it gets
-    # joint-limit bounds.
-    limited: np.ndarray
 
 
-def _actuated_joints(plant: MultibodyPlant, robot: Robot, held_frames: list[str]) -> _Joints:
-    held_bodies = {robot.frame(plant, name).body().index() for name in held_frames}
-    held_bodies.discard(plant.GetBodyByName(BASE_BODY, robot.model_instance).index())
+def _actuated_joints(plant: MultibodyPlant, robot: Robot) -> _Joints:
     # Indices into the robot's state: the chair and floor are welded, so the
     # robot's q and v are the plant's.
     actuated = actuated_joints(plant, robot.model_instance)
@@ -346,12 +341,6 @@ def _actuated_joints(plant: MultibodyPlant, robot: Robot, held_frames: list[str]
         v_indices=actuated.v_index,
         q_min=np.array([joint.position_lower_limits()[0] for joint in joints]),
         q_max=np.array([joint.position_upper_limits()[0] for joint in joints]),
-        limited=np.array(
-            [
-                not held_bodies & set(plant.GetBodiesKinematicallyAffectedBy([joint.index()]))
-                for joint in joints
-            ]
-        ),
     )
 
 
@@ -423,7 +412,7 @@ class WholeBodyController(LeafSystem):
         self._nv, self._nu = nv, nu = self._B.shape
         self.contact_specs = _contact_specs(plant, robot, config)
         held_frames = [spec.frame for spec in self.contact_specs if spec.constrained]
-        self._joints = joints = _actuated_joints(plant, robot, held_frames)
+        self._joints = joints = _actuated_joints(plant, robot)
         self._references = ReferenceGenerator(
             config,
             StandupSchedule(config, joints.names, joints.q_min, joints.q_max),
@@ -502,11 +491,6 @@ class WholeBodyController(LeafSystem):
         # Initialization event: the plant's first step already sees computed torques.
         self.DeclareInitializationDiscreteUpdateEvent(self._Update)
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
-
-    @property
-    def nominal_mass_kg(self) -> float:
-        """The robot's mass in the model the controller was built with, kg."""
-        return self._kinematics.nominal_mass_kg
 
     # --- Timing --------------------------------------------------------------------
 

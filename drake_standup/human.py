@@ -30,6 +30,32 @@ HANDS = {"left": 0, "right": 1}
 TASK_FRAMES = ("l_hand", "r_hand")
 
 
+def hand_forces(plant: MultibodyPlant, robot: Robot) -> list[ExternallyAppliedSpatialForce]:
+    """One applied force per hand (TASK_FRAMES), at the hand frame's origin; a human
+    source sets their forces each time it outputs them (spatial_forces)."""
+    applied = []
+    for name in TASK_FRAMES:
+        frame = robot.frame(plant, name)
+        force = ExternallyAppliedSpatialForce()
+        force.body_index = frame.body().index()
+        force.p_BoBq_B = frame.GetFixedPoseInBodyFrame().translation()
+        applied.append(force)
+    return applied
+
+
+def spatial_forces(
+    applied: list[ExternallyAppliedSpatialForce], hand_wrenches_W: np.ndarray
+) -> list[ExternallyAppliedSpatialForce]:
+    """applied (hand_forces) set to the forces of hand_wrenches_W = [0, f_l, 0, f_r], the
+    pulled hands only (none while nobody pulls: the plant then has nothing to apply)."""
+    pulled = []
+    for force, f in zip(applied, (hand_wrenches_W[3:6], hand_wrenches_W[9:12])):
+        if f.any():
+            force.F_Bq_W = SpatialForce(np.zeros(3), f)
+            pulled.append(force)
+    return pulled
+
+
 def trapezoid(t: float, start_s: float, duration_s: float, ramp_s: float) -> float:
     """0 -> 1 over ramp_s from start_s, 1, then 1 -> 0 over the last ramp_s."""
     local = t - start_s
@@ -204,14 +230,7 @@ class HumanWrenchSource(LeafSystem):
         self._instance = robot.model_instance
         self._context = plant.CreateDefaultContext()
         self._frames = [robot.frame(plant, name) for name in TASK_FRAMES]
-        # One applied force per hand, at the hand frame's origin; each tick
-        # sets its force only.
-        self._applied = []
-        for frame in self._frames:
-            applied = ExternallyAppliedSpatialForce()
-            applied.body_index = frame.body().index()
-            applied.p_BoBq_B = frame.GetFixedPoseInBodyFrame().translation()
-            self._applied.append(applied)
+        self._applied = hand_forces(plant, robot)
         nx = plant.num_multibody_states(self._instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         prereq = {self.time_ticket()}
@@ -299,12 +318,4 @@ class HumanWrenchSource(LeafSystem):
         output.SetFromVector(self._wrenches_cache.Eval(context))
 
     def _CalcSpatialForces(self, context: Context, output) -> None:
-        """One force per pulled hand (none while nobody pulls: the plant then
-        has nothing to apply)."""
-        wrenches = self._wrenches_cache.Eval(context)
-        forces = []
-        for applied, f in zip(self._applied, (wrenches[3:6], wrenches[9:12])):
-            if f.any():
-                applied.F_Bq_W = SpatialForce(np.zeros(3), f)
-                forces.append(applied)
-        output.set_value(forces)
+        output.set_value(spatial_forces(self._applied, self._wrenches_cache.Eval(context)))

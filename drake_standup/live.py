@@ -31,7 +31,6 @@ from pathlib import Path
 import numpy as np
 from pydrake.common.value import Value
 from pydrake.geometry import Meshcat, MeshcatParams
-from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import (
@@ -43,7 +42,7 @@ from pydrake.systems.framework import (
 )
 
 from drake_standup.config import HumanConfig, Scenario
-from drake_standup.human import TASK_FRAMES
+from drake_standup.human import hand_forces, spatial_forces
 from drake_standup.robot import Robot
 from drake_standup.simulate import RunResult, simulate
 
@@ -110,13 +109,7 @@ class LiveHumanSource(LeafSystem):
         self._cap = config.reactive.force_cap_N
         self._stand_up_button = stand_up_button
         self._clicks_seen = 0
-        frames = [robot.frame(plant, name) for name in TASK_FRAMES]
-        self._applied = []
-        for frame in frames:
-            applied = ExternallyAppliedSpatialForce()
-            applied.body_index = frame.body().index()
-            applied.p_BoBq_B = frame.GetFixedPoseInBodyFrame().translation()
-            self._applied.append(applied)
+        self._applied = hand_forces(plant, robot)
         self.DeclareVectorInputPort("robot_state", plant.num_multibody_states(robot.model_instance))
         self._index = self.DeclareDiscreteState(7)
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
@@ -187,18 +180,16 @@ class LiveHumanSource(LeafSystem):
     def _state(self, context: Context) -> np.ndarray:
         return context.get_discrete_state(self._index).value()
 
-    def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
+    def _wrenches(self, context: Context) -> np.ndarray:
+        """hand_wrenches_W (12,): [0, f_l, 0, f_r], from the page's last reading."""
         x = self._state(context)
-        output.SetFromVector(np.r_[np.zeros(3), x[0:3], np.zeros(3), x[3:6]])
+        return np.r_[np.zeros(3), x[0:3], np.zeros(3), x[3:6]]
+
+    def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
+        output.SetFromVector(self._wrenches(context))
 
     def _CalcSpatialForces(self, context: Context, output) -> None:
-        x = self._state(context)
-        forces = []
-        for applied, f in zip(self._applied, (x[0:3], x[3:6])):
-            if f.any():
-                applied.F_Bq_W = SpatialForce(np.zeros(3), f)
-                forces.append(applied)
-        output.set_value(forces)
+        output.set_value(spatial_forces(self._applied, self._wrenches(context)))
 
     def _CalcStandUp(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, self._state(context)[6])

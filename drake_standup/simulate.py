@@ -518,9 +518,7 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
         metrics["qp_relaxed_ticks"] = int(signals["qp_relaxed"][-1])
     if "model_mass_scale" in signals and len(signals["time_s"]):
         # The robot's mass as the controller estimated it (weighing itself seated).
-        metrics["model_mass_kg"] = float(
-            signals["model_mass_scale"][-1] * built.controller.nominal_mass_kg
-        )
+        metrics["model_mass_kg"] = float(signals["model_mass_scale"][-1] * mass_kg)
     if "held_back_s" in signals and len(signals["time_s"]):
         # How long the stand-up waited for a pull against it to stop (state machine).
         metrics["held_back_s"] = float(signals["held_back_s"][-1])
