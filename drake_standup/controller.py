@@ -418,8 +418,7 @@ class WholeBodyController(LeafSystem):
             StandupSchedule(config, joints.names, joints.q_min, joints.q_max),
             as_slice(joints.q_indices),
             period_s,
-            weight_N=-plant.CalcTotalMass(plant.CreateDefaultContext(), [robot.model_instance])
-            * plant.gravity_field().gravity_vector()[2],
+            gravity_mps2=-plant.gravity_field().gravity_vector()[2],
         )
         self._posture_weights = joint_values(
             joints.names,

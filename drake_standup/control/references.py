@@ -211,10 +211,13 @@ class ReferenceGenerator:
         schedule: StandupSchedule,
         q_joints: slice | np.ndarray,
         period_s: float,
-        weight_N: float = 0.0,
+        gravity_mps2: float = 0.0,
     ):
-        """q_joints: the actuated joints' entries of q, in the schedule's order; weight_N:
-        the robot's weight m g (the plant's gravity), for the lean against the pull."""
+        """q_joints: the actuated joints' entries of q, in the schedule's order;
+        gravity_mps2: g, the plant's. The robot's weight is that of the model the terms
+        are computed with (terms.mass_kg g: the controller's estimate once it has
+        weighed the robot), for the lean against the pull and the height integral's
+        bound."""
         self._config = config
         self.schedule = schedule
         self._q_joints = q_joints
@@ -223,7 +226,7 @@ class ReferenceGenerator:
         self._latched = np.ones(1)  # the posture state's latched flag
         # The base's target orientation for the last (yaw, pitch), rad.
         self._base_target = (None, None), None
-        self._weight_N = weight_N
+        self._gravity_mps2 = gravity_mps2
         self._period_s = period_s
         self._lean_blend = min(period_s / config.lean_filter_time_constant_s, 1.0)
 
@@ -247,7 +250,10 @@ class ReferenceGenerator:
             wrench = tau_hand[:6].copy()
             wrench[:3] -= np.cross(terms.p_BoCom, wrench[3:])
             target = static_lean(
-                wrench, float(terms.p_WCom[2]), self._weight_N, self._config.lean_max_m
+                wrench,
+                float(terms.p_WCom[2]),
+                terms.mass_kg * self._gravity_mps2,
+                self._config.lean_max_m,
             )
             target[0] = min(
                 max(target[0], -self._config.lean_max_back_m), self._config.lean_max_forward_m
@@ -307,7 +313,7 @@ class ReferenceGenerator:
         next_height_integral = 0.0
         if stance > 0.0:
             ki = config.stance_height_ki_per_s3
-            limit = 0.2 * (self._weight_N / terms.mass_kg) / ki  # 20 % of g, the plant's
+            limit = 0.2 * self._gravity_mps2 / ki  # 20 % of g, the plant's
             next_height_integral = min(
                 max(
                     height_integral
