@@ -43,13 +43,13 @@ from pydrake.multibody.tree import (
     RevoluteJoint,
 )
 
+from drake_standup.config.scenario import EFFORT_LIMIT_NM
 from drake_standup.meshes import cache_dir, converted_obj
 from drake_standup.resources import model_file
 
 DEFAULT_MODEL = "iCubGazeboV2_5"
 # Torque saturation of the authors' controller (SPEC 3): every actuator's effort limit,
 # which the whole-body controller reads from the plant. N m.
-EFFORT_LIMIT_NM = 60.0
 CONTACT_FILE = model_file("icub_contact.yaml")
 
 

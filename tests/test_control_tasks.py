@@ -11,12 +11,11 @@ import numpy as np
 import pytest
 from pydrake.systems.framework import DiagramBuilder
 
-from drake_standup.config import Scenario
+from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
 from drake_standup.control.qp import ContactCommands, ContactMap, QpLayout, Task, WholeBodyQp
 from drake_standup.control.references import TaskReferences, static_lean
 from drake_standup.control.terms import RobotKinematics, RobotTerms
-from drake_standup.controller import ControllerConfig, WholeBodyController
-from drake_standup.robot import EFFORT_LIMIT_NM
+from drake_standup.controller import WholeBodyController
 from drake_standup.scene import add_scene, set_seated_state
 
 TARGET_RAD_PER_S2 = 2.0

@@ -16,11 +16,10 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from drake_standup.config import Scenario
+from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
 from drake_standup.control.references import helpful_force
 from drake_standup.control.terms import RobotKinematics
-from drake_standup.controller import ControllerConfig, WholeBodyController
-from drake_standup.robot import EFFORT_LIMIT_NM
+from drake_standup.controller import WholeBodyController
 from drake_standup.scene import add_scene, set_seated_state
 
 G = 9.81
@@ -505,8 +504,6 @@ def test_ports_and_config(scene):
     )
     assert config.qp_solver == "clarabel" and config.com_kp_seated_per_s2 == [1.0, 2.0, 3.0]
     assert config.posture_state4_rad == ControllerConfig().posture_state4_rad
-    with pytest.raises(ValueError, match="qp_solver"):
-        _controller(scene, qp_solver="cplex")
     with pytest.raises(ValueError, match="posture_state2_rad"):
         _controller(scene, posture_state2_rad={"no_such_joint": 0.0})
 

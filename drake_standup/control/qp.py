@@ -46,12 +46,12 @@ from pydrake.solvers import (
     SolverOptions,
 )
 
+from drake_standup.config.controller import QP_SOLVERS as SOLVERS
 from drake_standup.control.contacts import WRENCH_SIZE, ContactSpec, wrench_cone_matrix
 from drake_standup.control.references import STATES, TaskReferences
 from drake_standup.control.terms import RobotTerms
 
 N_BASE = 6  # unactuated floating-base velocities
-SOLVERS = ("daqp", "osqp", "clarabel")
 
 
 class QpLayout:

@@ -37,16 +37,13 @@ The posture reference and the base's target orientation:
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from drake_standup.config import ControllerConfig
 from drake_standup.control.spatial import yaw_pitch_rotation
 from drake_standup.control.terms import RobotTerms
 from drake_standup.reference import smoothstep
-
-if TYPE_CHECKING:
-    from drake_standup.controller import ControllerConfig
 
 STATES = (1, 2, 3, 4)
 
@@ -118,7 +115,7 @@ class StandupSchedule:
 
     def __init__(
         self,
-        config: "ControllerConfig",
+        config: ControllerConfig,
         joint_names: list[str],
         q_min: np.ndarray,
         q_max: np.ndarray,
@@ -207,7 +204,7 @@ class ReferenceGenerator:
 
     def __init__(
         self,
-        config: "ControllerConfig",
+        config: ControllerConfig,
         schedule: StandupSchedule,
         q_joints: slice | np.ndarray,
         period_s: float,

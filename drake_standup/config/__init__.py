@@ -1,0 +1,69 @@
+"""Scenario: every number a run uses, and the one place that checks a run's inputs.
+
+scenario.py    the typed sections of a scenario (robot, human, advancement, standup, ...)
+controller.py  the whole-body controller's gains, weights and limits
+loading.py     a YAML file and overrides into those dataclasses (Drake's yaml_load_typed)
+rules.py       the bounds and accepted values of every field, and the checks across fields
+errors.py      ScenarioError: one line naming the key or file
+"""
+
+from drake_standup.config.controller import QP_SOLVERS, ControllerConfig
+from drake_standup.config.errors import ScenarioError
+from drake_standup.config.loading import (
+    apply_overrides,
+    expand_key_path,
+    load_scenario,
+    parse_scenario,
+)
+from drake_standup.config.rules import RULES, Range, validate
+from drake_standup.config.scenario import (
+    DEFAULT_SCENARIO,
+    EFFORT_LIMIT_NM,
+    SCENARIO_DIR,
+    AdvancementConfig,
+    ChairConfig,
+    FallConfig,
+    HumanConfig,
+    InitialPose,
+    PerturbationConfig,
+    Pull,
+    Push,
+    ReactiveHumanConfig,
+    RobotConfig,
+    Scenario,
+    SeatHoldConfig,
+    StandupConfig,
+    VisualizationConfig,
+    chair_file,
+)
+
+__all__ = [
+    "DEFAULT_SCENARIO",
+    "EFFORT_LIMIT_NM",
+    "QP_SOLVERS",
+    "RULES",
+    "SCENARIO_DIR",
+    "AdvancementConfig",
+    "ChairConfig",
+    "ControllerConfig",
+    "FallConfig",
+    "HumanConfig",
+    "InitialPose",
+    "PerturbationConfig",
+    "Pull",
+    "Push",
+    "Range",
+    "ReactiveHumanConfig",
+    "RobotConfig",
+    "Scenario",
+    "ScenarioError",
+    "SeatHoldConfig",
+    "StandupConfig",
+    "VisualizationConfig",
+    "apply_overrides",
+    "chair_file",
+    "expand_key_path",
+    "load_scenario",
+    "parse_scenario",
+    "validate",
+]

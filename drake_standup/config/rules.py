@@ -1,0 +1,214 @@
+"""Bounds and accepted values of every field (RULES), and the checks across fields.
+
+validate(scenario) is what the types alone cannot say; every message is one line naming
+the key path and what it accepts.
+"""
+
+import math
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import icub_models
+import yaml
+from pydrake.common.yaml import yaml_dump_typed
+from pydrake.systems.analysis import GetIntegrationSchemes
+
+from drake_standup.config.controller import QP_SOLVERS
+from drake_standup.config.errors import ScenarioError
+from drake_standup.config.scenario import Scenario, chair_file
+
+
+@dataclass(frozen=True)
+class Range:
+    """Numbers from low to high; an open end excluded."""
+
+    low: float = 0.0
+    high: float = math.inf
+    low_open: bool = False
+    high_open: bool = False
+
+    def accepts(self, x) -> bool:
+        above = x > self.low if self.low_open else x >= self.low
+        return above and (x < self.high if self.high_open else x <= self.high)
+
+    def __str__(self) -> str:
+        if self.high == math.inf:
+            return f"a number {'>' if self.low_open else '>='} {self.low:g}"
+        left, right = "(["[not self.low_open], ")]"[not self.high_open]
+        return f"a number in {left}{self.low:g}, {self.high:g}{right}"
+
+
+INTERVAL = "interval"  # two numbers [low, high] with low < high
+POSITIVE, NON_NEGATIVE, FRACTION = Range(low_open=True), Range(), Range(high=1.0)
+
+# What the values at some key paths accept: a Range (of each entry of a list too), a length
+# n (a list of n entries), INTERVAL or a tuple of accepted strings. The key paths are
+# patterns separated by spaces, '*' standing for any part of a name and '[*]' for any list
+# index. Checked in this order (tests/test_config.py: every pattern names a key).
+RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
+    (("scripted", "reactive"), "human.mode"),
+    (("left", "right"), "human.pulls[*].hand"),
+    (("velocity", "path"), "human.reactive.guide"),
+    (("tangent", "interaction"), "advancement.law"),
+    (("hands", "time"), "standup.trigger"),
+    (QP_SOLVERS, "controller.qp_solver"),
+    (tuple(GetIntegrationSchemes()), "simulator.integration_scheme"),
+    (("point", "hydroelastic", "hydroelastic_with_fallback"), "plant.contact_model"),
+    (("", "tamsi", "sap", "similar", "lagged"), "plant.discrete_contact_approximation"),
+    (("triangle", "polygon"), "plant.contact_surface_representation"),
+    (
+        POSITIVE,
+        "duration_s log_period_s controller_period_s simulator.max_step_size "
+        "robot.effort_limit_Nm robot.visual_max_faces visualization.*period_s "
+        "human.pulls[*].duration_s human.reactive.duration_s human.reactive.force_cap_N "
+        "human.reactive.pace_mps advancement.eps advancement.psi_ddot_filter_s "
+        "standup.segment_psi standup.standing_com_height_m standup.update_period_s "
+        "controller.momentum_weight controller.*_time_constant_s "
+        "controller.joint_limit_horizon_s controller.*friction_coefficient* "
+        "controller.*_max_normal_force_N controller.torque_limit_Nm controller.help_* "
+        "controller.mass_scale_bounds "
+        "fall.max_com_horizontal_m perturbation.pushes[*].duration_s perturbation.*_scale "
+        "perturbation.hand_wrench_noise_period_s plant.penetration_allowance "
+        "plant.stiction_tolerance simulator.accuracy",
+    ),
+    (
+        NON_NEGATIVE,
+        "plant.time_step human.pulls[*].start_s human.pulls[*].ramp_s "
+        "human.reactive.start_s human.reactive.ramp_s human.reactive.stiffness_N_per_m "
+        "human.reactive.damping_Ns_per_m human.reactive.travel_m "
+        "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
+        "human.reactive.ease_com_rise_m advancement.alpha_*_mps2 advancement.lag_tolerance_m "
+        "standup.*_s standup.*_N standup.com_ahead_of_heels_m controller.*_weight "
+        "controller.*weight_by_joint.* controller.*_kp_* controller.*_kd_* controller.*_ki_* "
+        "controller.*_damping_ratio controller.posture_limit_margin_rad controller.*_N "
+        "controller.lean_max_* controller.mass_estimation_filter_s seat_hold.* "
+        "fall.max_qp_failure_streak_s "
+        "perturbation.pushes[*].start_s perturbation.hand_wrench_noise_N "
+        "perturbation.noise_seed plant.sap_near_rigid_threshold simulator.target_realtime_rate "
+        "simulator.start_time fall.min_root_height_m",
+    ),
+    (Range(low=1.0), "advancement.psi_dot_upper"),
+    (Range(high=1.0, high_open=True), "advancement.taper_from_progress"),
+    (Range(high=1.0, high_open=True), "controller.stance_from_progress"),
+    (
+        FRACTION,
+        "standup.guard_off_ratio standup.reseat_above_thigh_load "
+        "controller.stance_vertical_weight_scale",
+    ),
+    (Range(1.0, 4.0), "controller.seat_hinge_from_state controller.lean_states"),
+    (2, "human.reactive.path_xz_m[*]"),
+    (
+        3,
+        "initial.base_* visualization.*_xyz_m chair.xyz_m human.pulls[*].force_N "
+        "human.reactive.target_velocity_mps standup.segment_psi standup.state*_com_delta_m "
+        "controller.com_kp_* perturbation.pushes[*].force_N",
+    ),
+    (4, "controller.base_pitch_by_state_rad"),
+    (
+        INTERVAL,
+        "human.reactive.ease_com_rise_m controller.*_cop_*_m controller.mass_scale_bounds",
+    ),
+]
+
+
+def _pattern(rule: str) -> re.Pattern:
+    text = re.escape(rule).replace(r"\[\*\]", r"\[\d+\]").replace(r"\*", r"[^.\[]*")
+    return re.compile(text)
+
+
+_COMPILED = [(_pattern(rule), accepted) for accepted, rules in RULES for rule in rules.split()]
+
+
+def _nodes(data, steps: tuple = (), leaves: bool = False) -> Iterator[tuple[list, object]]:
+    """(key path steps, value) of every node of plain data (leaves: of every leaf only;
+    an empty list is a leaf)."""
+    kind = dict if isinstance(data, dict) else list if isinstance(data, list) else None
+    items = list(data.items() if kind is dict else enumerate(data) if kind else ())
+    if steps and not (leaves and items):
+        yield list(steps), data
+    for key, value in items:
+        yield from _nodes(value, (*steps, key), leaves)
+
+
+def _format(steps: list[str | int]) -> str:
+    return "".join(f"[{s}]" if isinstance(s, int) else f".{s}" for s in steps)[1:]
+
+
+def _check(key: str, value, accepted) -> None:
+    if value is None:  # an optional value left out
+        return
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ScenarioError(f"{key}: {value} is not finite; accepted: a finite number")
+    if isinstance(value, list) and isinstance(accepted, Range | tuple):
+        for i, item in enumerate(value):
+            _check(f"{key}[{i}]", item, accepted)
+    elif isinstance(accepted, tuple):
+        if value not in accepted:
+            raise ScenarioError(f"{key}: '{value}' unknown; accepted: {' | '.join(accepted)}")
+    elif isinstance(accepted, int):
+        if len(value) != accepted:
+            raise ScenarioError(
+                f"{key}: {len(value)} values; accepted: a list of {accepted} numbers"
+            )
+    elif accepted == INTERVAL:
+        if len(value) != 2 or not value[0] < value[1]:
+            raise ScenarioError(f"{key}: {value}; accepted: [low, high] with low < high")
+    elif accepted is not None and not accepted.accepts(value):
+        raise ScenarioError(f"{key}: {value}; accepted: {accepted}")
+
+
+def validate(scenario: Scenario) -> Scenario:
+    """Checks what the types alone cannot; raises ScenarioError (one line). Returns
+    scenario."""
+    for steps, value in _nodes(yaml.safe_load(yaml_dump_typed(scenario))):
+        key = _format(steps)
+        _check(key, value, None)
+        for pattern, accepted in _COMPILED:
+            if pattern.fullmatch(key):
+                _check(key, value, accepted)
+    if scenario.robot.model not in sorted(icub_models.get_robot_names()):
+        raise ScenarioError(
+            f"robot.model: unknown model '{scenario.robot.model}'; "
+            f"accepted: {', '.join(sorted(icub_models.get_robot_names()))}"
+        )
+    # The controller's period is a whole multiple of a discrete plant's step: the plant
+    # reads its actuation input only at its own steps, so a faster controller is wasted
+    # work and a period off the plant's grid jitters.
+    step, period = scenario.plant.time_step, scenario.controller_period_s
+    ratio = period / step if step > 0 else 1.0  # a continuous plant: any period
+    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+        raise ScenarioError(
+            f"controller_period_s: {period}; accepted: a whole multiple of plant.time_step "
+            f"({step}), e.g. {step} or {2 * step}"
+        )
+    if not chair_file(scenario.chair.file).is_file():
+        raise ScenarioError(
+            f"chair.file: '{scenario.chair.file}' not found; accepted: an SDF file path "
+            "(absolute or relative to the current directory), or models/chair.sdf"
+        )
+    for i, pull in enumerate(scenario.human.pulls):
+        if 2 * pull.ramp_s > pull.duration_s:
+            raise ScenarioError(
+                f"human.pulls[{i}].ramp_s: {pull.ramp_s}; accepted: at most half of "
+                f"duration_s ({pull.duration_s / 2})"
+            )
+    reactive = scenario.human.reactive
+    if not reactive.path_xz_m:
+        raise ScenarioError(
+            "human.reactive.path_xz_m: empty; accepted: a list of [forward, up] waypoints, m"
+        )
+    previous = [0.0, 0.0]
+    for i, point in enumerate(reactive.path_xz_m):
+        if math.dist(point, previous) < 1e-3:
+            raise ScenarioError(
+                f"human.reactive.path_xz_m[{i}]: {point}; accepted: a waypoint at least 1 mm "
+                f"from the one before ({previous}; the path starts at [0, 0])"
+            )
+        previous = point
+    if not reactive.lead_max_m >= reactive.lead_min_m:
+        raise ScenarioError(
+            f"human.reactive.lead_max_m: {reactive.lead_max_m}; accepted: a number >= "
+            f"lead_min_m ({reactive.lead_min_m})"
+        )
+    return scenario
