@@ -65,6 +65,7 @@ from drake_standup.control.tasks import (
     StancePostureTask,
 )
 from drake_standup.control.terms import RobotKinematics, RobotTerms
+from drake_standup.phases import PhaseTable
 from drake_standup.robot import Robot, actuated_joints
 
 
@@ -176,9 +177,12 @@ class WholeBodyController(LeafSystem):
         plant: MultibodyPlant,
         robot: Robot,
         config: ControllerConfig,
+        table: PhaseTable | None = None,
         period_s: float = 0.001,
     ):
         super().__init__()
+        table = PhaseTable() if table is None else table
+        self._stance_states = {k for k, phase in enumerate(table, start=1) if phase.stance}
         self._config = config
         self._period_s = period_s
         self._B = plant.MakeActuationMatrix()
@@ -192,7 +196,7 @@ class WholeBodyController(LeafSystem):
         self._joints = joints = _actuated_joints(plant, robot)
         self._references = ReferenceGenerator(
             config,
-            StandupSchedule(config, joints.names, joints.q_min, joints.q_max),
+            StandupSchedule(table, config, joints.names, joints.q_min, joints.q_max),
             as_slice(joints.q_indices),
             period_s,
             gravity_mps2=-plant.gravity_field().gravity_vector()[2],
@@ -392,8 +396,10 @@ class WholeBodyController(LeafSystem):
                 posture(PostureTask, self._posture_weights),
                 # State 4: the legs (and the arms a little) from its start; the arms
                 # more as the stance grows (ControllerConfig.stance_*).
-                posture(PostureTask, self._stance_weights, "stance_posture", {4}),
-                posture(StancePostureTask, self._stance_arm_weights, "stance_arms", {4}),
+                posture(PostureTask, self._stance_weights, "stance_posture", self._stance_states),
+                posture(
+                    StancePostureTask, self._stance_arm_weights, "stance_arms", self._stance_states
+                ),
                 BaseOrientationTask(
                     layout,
                     config.base_orientation_weight,

@@ -107,7 +107,8 @@ def build_diagram(
         if s.frame == frame
     )
     state_machine = builder.AddNamedSystem(
-        "state_machine", StandupStateMachine(scenario.standup, len(pad_names), sole_rows)
+        "state_machine",
+        StandupStateMachine(scenario.standup, scenario.phases, len(pad_names), sole_rows),
     )
 
     robot_state = plant.get_state_output_port(instance)
@@ -137,7 +138,7 @@ def build_diagram(
     if controller == "whole_body":
         try:
             whole_body = WholeBodyController(
-                plant, robot, scenario.controller, scenario.controller_period_s
+                plant, robot, scenario.controller, scenario.phases, scenario.controller_period_s
             )
         except ValueError as err:  # a setting only the model can check: a joint's name
             raise ScenarioError(" ".join(str(err).split())) from None

@@ -501,7 +501,7 @@ def _collect(built: StandupDiagram, root_context, scenario: Scenario) -> RunResu
             signals,
             metrics["state_entry_times_s"],
             standing_height_m=erect_com_height_m(
-                built.scene, scenario, scenario.controller.posture_state4_rad
+                built.scene, scenario, scenario.phases.rise.posture_rad
             ),
         )
     )

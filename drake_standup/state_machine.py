@@ -1,41 +1,26 @@
-"""StandupStateMachine: the four states of the stand-up and their guards.
+"""StandupStateMachine: the four states of the stand-up, as the phase table declares them.
 
-    1 balance seated     -> 2 after balance_time_s, and with trigger 'hands'
-                              once both hands feel a forward pull > threshold
-                              or the stand_up input says go (live mode's button)
-    2 CoM forward, the buttocks unloaded over seat_unload_s
-                         -> 3 after min_time_state2_s, the state-2 segment done,
-                              feet normal forces together > feet_force_2to3_N,
-                              the CoM >= com_ahead_of_heels_m in front of the heels
-    3 CoM forward, the thighs unloaded over seat_release_s
-                         -> 4 after min_time_state3_s and the release, the
-                              segment done, each foot's normal force >
-                              foot_force_3to4_N
-    4 CoM up to standing (final)
-(SPEC 3 and 7.) "Segment done" (psi past the segment's end) keeps the
-reference's slope continuous across switches; with psi_dot >= 1 it costs
-nothing when the dwell time is at least the segment length. One switch per
-update at most, so no state is ever skipped.
+What each state does and the guard that leaves it are the phase table's (phases.py);
+this module is its mechanism, in pure functions on an immutable StandupMode:
 
-The force guards read low-pass filtered forces (first order,
-force_filter_time_constant_s) through Schmitt triggers: a condition turns on
-once its filtered force has stayed above the threshold for guard_dwell_s, and
-off once it has stayed below guard_off_ratio times the threshold for as long,
-so noise around a threshold cannot flip a guard back and forth. The filters
-and triggers live in the mode: next_mode stays a pure function.
-
-The contact plan says what is left of each seat pad's load while it unloads
-(NaN while seated): the buttocks from 1 to 0 over seat_unload_s from state 2,
-each thigh over seat_release_s from state 3 (smoothstep in both).
-
-A pull against the stand-up (both hands together pulled backwards by more than
-hindering_force_threshold_N, through the same filter and trigger) waits: state 1
-does not start; state 2, and state 3 while the thighs carry more than
-reseat_above_thigh_load of their load, sit back into state 1 (_reseat: the
-reference returns to the seated CoM); later in state 3, the thighs unloading, the
-robot goes back onto them in state 2 (_back_to_state_2: the reference held); once
-they are off the chair state 3 holds. The stand-up goes on resume_after_s after
-the pull stops.
+- update_guards: the forces the guards read, low-pass filtered (first order,
+  standup.force_filter_time_constant_s), through Schmitt triggers: a condition turns on
+  once its filtered force has stayed above the threshold for guard_dwell_s, and off once
+  it has stayed below guard_off_ratio times the threshold as long, so noise around a
+  threshold cannot flip it back and forth.
+- next_mode: one update. A phase is left for the next one when every condition of its
+  Guard holds and no pull against the stand-up has been felt for standup.resume_after_s;
+  one switch per update at most, so no state is ever skipped. "Segment done" (psi past
+  the segment's end) keeps the reference's slope continuous across switches.
+- seat_loads: what is left of each seat pad's load while the phases release it (NaN
+  while the pad is seated): the contact schedule's input (control/schedule.py).
+- A pull against the stand-up (both hands together pulled backwards by more than
+  standup.hindering_force_threshold_N, through the same filter and trigger) is answered
+  by the phase's when_hindered: wait (the guards wait for calm), sit_back (_sit_back: the
+  reference returns to the seated CoM, state 1 again), step_back (while the pads this
+  phase releases still carry more than reseat_above_thigh_load of their load: sit back;
+  while they unload: back to the previous phase, _step_back; once off: wait) or stand
+  (the standing robot leans against it; not waiting).
 """
 
 from __future__ import annotations
@@ -49,9 +34,12 @@ from pydrake.common.value import Value
 from pydrake.systems.framework import BasicVector, Context, LeafSystem, State
 
 from drake_standup.config import StandupConfig
-from drake_standup.reference import SEGMENT_SIZE, path, smoothstep
+from drake_standup.payloads import SEGMENT
+from drake_standup.phases import PHASES, SEAT_PADS, Guard, Phase, PhaseTable
+from drake_standup.reference import path, smoothstep
 
-N_STATES = 4
+N_STATES = len(PHASES)
+_NAN3 = (math.nan, math.nan, math.nan)
 
 
 @dataclass(frozen=True)
@@ -76,25 +64,29 @@ class SchmittTrigger:
         return SchmittTrigger(self.on, since)
 
 
+_OFF = SchmittTrigger()
+
+
 @dataclass(frozen=True)
 class GuardSignals:
-    """Filtered forces and the triggers the guards read."""
+    """Filtered forces and the triggers the guards read; feet_loaded[k] and
+    each_foot_loaded[k] are phase k+1's exit conditions (off where it has none)."""
 
     t: float = math.nan  # time of the last update (NaN: none yet)
     foot_fz_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
     hand_fx_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
-    hands_pulled: SchmittTrigger = SchmittTrigger()  # both hands > hand threshold
-    feet_loaded: SchmittTrigger = SchmittTrigger()  # the feet together > feet_force_2to3_N
-    each_foot_loaded: SchmittTrigger = SchmittTrigger()  # each foot > foot_force_3to4_N
+    hands_pulled: SchmittTrigger = _OFF  # both hands > hand_force_threshold_N
+    feet_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # the feet together
+    each_foot_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # each foot
     # Both hands together pulled backwards (against the stand-up) by more than
     # hindering_force_threshold_N.
-    hindered: SchmittTrigger = SchmittTrigger()
+    hindered: SchmittTrigger = _OFF
 
 
 @dataclass(frozen=True)
 class StandupMode:
     """The machine's abstract state: where it is, the active CoM segment, the guards'
-    filtered signals and the seat pads' loads when their unloading began."""
+    filtered signals, and what a pull against the stand-up has done."""
 
     state: int = 1
     entry_times_s: tuple[float, ...] = (0.0,) + (math.nan,) * (N_STATES - 1)
@@ -104,29 +96,33 @@ class StandupMode:
     delta_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     guards: GuardSignals = GuardSignals()
     held_back_s: float = 0.0  # time spent waiting for a hindering pull to stop
-    # Where the CoM sat at the start: a stand-up sat back by a hindering pull returns
-    # there, so that its next state-2 segment starts where the first one did.
+    # Where the CoM sat at the start: a sit-back returns there, so that the next
+    # forward segment starts where the first one did.
     x_seated_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     hindered_until_s: float = -math.inf  # the last time a hindering pull was felt
-    # State 3 sent back to state 2 by a hindering pull: where its segment was to end
-    # (NaN: not sent back). The next state 3 ends there.
-    state3_end_m: tuple[float, float, float] = (math.nan, math.nan, math.nan)
+    # A step back from a phase: where its segment was to end (NaN: none). The phase,
+    # entered again, ends there.
+    resume_end_m: tuple[float, float, float] = _NAN3
+    sat_back: bool = False  # a hindering pull has sat the robot back since the start
 
     def __copy__(self) -> StandupMode:
         return self
 
     def __deepcopy__(self, memo: dict) -> StandupMode:
-        """Itself: the mode is immutable. Drake clones the abstract state (a
-        Python deepcopy) into and out of its scratch state at every
-        unrestricted update of the diagram, i.e. at every plant step: real
-        copies cost ~15 us a step (measured)."""
+        """Itself: the mode is immutable. Drake clones the abstract state (a Python
+        deepcopy) into and out of its scratch state at every unrestricted update of the
+        diagram, i.e. at every plant step: real copies cost ~15 us a step (measured)."""
         return self
 
     def segment(self) -> np.ndarray:
+        """[psi_entry, T, x_start, delta] (payloads.SEGMENT)."""
         return np.array([self.psi_entry, self.segment_psi, *self.x_start_m, *self.delta_m])
 
     def segment_end(self) -> np.ndarray:
         return np.array(self.x_start_m) + np.array(self.delta_m)
+
+    def stepped_back(self) -> bool:
+        return not math.isnan(self.resume_end_m[0])
 
 
 @dataclass(frozen=True)
@@ -144,20 +140,23 @@ class Measurements:
     stand_up: bool = False
 
 
-def initial_mode(com0_W: np.ndarray) -> StandupMode:
-    """State 1 at t = 0, holding the CoM where it starts."""
+def initial_mode(com0_W: np.ndarray, t: float = 0.0) -> StandupMode:
+    """State 1 at t, holding the CoM where it starts."""
     com0 = tuple(float(c) for c in com0_W)
-    return StandupMode(x_start_m=com0, x_seated_m=com0)
+    entry = (t,) + (math.nan,) * (N_STATES - 1)
+    return StandupMode(entry_times_s=entry, x_start_m=com0, x_seated_m=com0)
 
 
 def _low_pass(previous: tuple[float, ...], raw: tuple[float, ...], gain: float) -> tuple:
     return tuple(float(y + gain * (x - y)) for y, x in zip(previous, raw, strict=True))
 
 
-def update_guards(g: GuardSignals, m: Measurements, cfg: StandupConfig) -> GuardSignals:
+def update_guards(
+    g: GuardSignals, m: Measurements, cfg: StandupConfig, table: PhaseTable
+) -> GuardSignals:
     """The guards' signals after a measurement: forces filtered (first order, exact for a
     step held over the update: gain 1 - exp(-dt / tau); the first measurement starts the
-    filters), then the triggers."""
+    filters), then the triggers of every phase's exit."""
     if math.isnan(g.t):
         feet, hands = tuple(m.foot_fz_N), tuple(m.hand_fx_N)
     else:
@@ -166,80 +165,92 @@ def update_guards(g: GuardSignals, m: Measurements, cfg: StandupConfig) -> Guard
         feet = _low_pass(g.foot_fz_N, m.foot_fz_N, gain)
         hands = _low_pass(g.hand_fx_N, m.hand_fx_N, gain)
     off, dwell = cfg.guard_off_ratio, cfg.guard_dwell_s
-    hand_on, feet_on, foot_on, back_on = (
-        cfg.hand_force_threshold_N,
-        cfg.feet_force_2to3_N,
-        cfg.foot_force_3to4_N,
-        cfg.hindering_force_threshold_N,
-    )
+
+    def trigger(trigger: SchmittTrigger, value: float, threshold: float | None):
+        if threshold is None:
+            return trigger
+        return trigger.update(value, m.t, threshold, off * threshold, dwell)
+
+    hand_on, back_on = cfg.hand_force_threshold_N, cfg.hindering_force_threshold_N
+    exits = [phase.exit for phase in table]
     return GuardSignals(
         t=m.t,
         foot_fz_N=feet,
         hand_fx_N=hands,
         hands_pulled=g.hands_pulled.update(min(hands), m.t, hand_on, off * hand_on, dwell),
-        feet_loaded=g.feet_loaded.update(sum(feet), m.t, feet_on, off * feet_on, dwell),
-        each_foot_loaded=g.each_foot_loaded.update(min(feet), m.t, foot_on, off * foot_on, dwell),
+        feet_loaded=tuple(
+            trigger(k, sum(feet), e.feet_force_N) for k, e in zip(g.feet_loaded, exits)
+        ),
+        each_foot_loaded=tuple(
+            trigger(k, min(feet), e.each_foot_force_N) for k, e in zip(g.each_foot_loaded, exits)
+        ),
         hindered=g.hindered.update(-sum(hands), m.t, back_on, off * back_on, dwell),
     )
 
 
-def next_mode(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> StandupMode:
-    """The mode after one update: its guards' signals updated, in the same or the next
-    state."""
-    g = update_guards(mode.guards, m, cfg)
+def next_mode(
+    mode: StandupMode, m: Measurements, cfg: StandupConfig, table: PhaseTable
+) -> StandupMode:
+    """The mode after one update: its guards' signals updated, in the same, the next or
+    (under a pull against the stand-up) an earlier state."""
+    g = update_guards(mode.guards, m, cfg, table)
+    phase = table.phase(mode.state)
     held = mode.held_back_s
-    if g.hindered.on and mode.state < 4 and not math.isnan(mode.guards.t):
+    if g.hindered.on and phase.when_hindered != "stand" and not math.isnan(mode.guards.t):
         held += m.t - mode.guards.t
     hindered_until = m.t if g.hindered.on else mode.hindered_until_s
     mode = dataclasses.replace(mode, guards=g, held_back_s=held, hindered_until_s=hindered_until)
-    dwell = m.t - mode.entry_times_s[mode.state - 1]
-    segment_done = m.psi - mode.psi_entry >= mode.segment_psi
-    hindered = g.hindered.on
-    calm = not hindered and m.t - mode.hindered_until_s >= cfg.resume_after_s
-    if hindered and mode.state == 3:
-        thighs = seat_unloading(mode, m.t, cfg)[1]
-        if thighs > cfg.reseat_above_thigh_load:  # the thighs still carry the robot
-            return _reseat(mode, m, cfg)
-        if thighs > 0.0:  # the thighs unloading: back onto them
-            return _back_to_state_2(mode, m)
-    if hindered and mode.state == 2 and math.isnan(mode.state3_end_m[0]):
-        return _reseat(mode, m, cfg)
-    if mode.state == 1:
-        asked = cfg.trigger == "time" or g.hands_pulled.on or m.stand_up
-        go = dwell >= cfg.balance_time_s and asked
-        go = go and calm and (segment_done or not any(mode.delta_m))
-    elif mode.state == 2:
-        go = (
-            dwell >= cfg.min_time_state2_s
-            and segment_done
-            and g.feet_loaded.on
-            and m.com_W[0] >= m.heel_x + cfg.com_ahead_of_heels_m
-            and calm
-        )
-    elif mode.state == 3:
-        go = (
-            dwell >= cfg.min_time_state3_s
-            and dwell >= cfg.seat_release_s  # the thighs unloaded
-            and segment_done
-            and g.each_foot_loaded.on
-            and calm
-        )
-    else:
-        go = False
-    if not go:
+    if g.hindered.on:
+        if phase.when_hindered == "step_back":
+            left = max(seat_loads(mode, m.t, table)[_released(phase)], default=0.0)
+            if left > cfg.reseat_above_thigh_load:  # the pads still carry the robot
+                return _sit_back(mode, m, table)
+            if left > 0.0:  # unloading: back onto them
+                return _step_back(mode, m)
+        elif phase.when_hindered == "sit_back" and not mode.stepped_back():
+            return _sit_back(mode, m, table)
+    calm = not g.hindered.on and m.t - mode.hindered_until_s >= cfg.resume_after_s
+    if mode.state == N_STATES or not (calm and guard_holds(phase, mode, m, cfg)):
         return mode
-    return _enter(mode, mode.state + 1, m, cfg)
+    return _enter(mode, mode.state + 1, m, table)
 
 
-def _reseat(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> StandupMode:
-    """Back to state 1 from state 2, or from state 3 while the thighs still carry more
-    than reseat_above_thigh_load of their load: a pull against
-    the stand-up waits seated (the paper: psi = t, nothing advances). The state-1
-    segment starts where the reference is now (no jump) and returns to where the CoM
-    sat at the start, at the pace of the state-2 segment; state 1's balancing time runs
-    again from now, and state 2 waits for the return. Held where it was instead, the
-    next state-2 segment started from there and every later one ended its offset (6 cm
-    forward) further on: the robot stood up past its toes and fell (measured)."""
+def guard_holds(phase: Phase, mode: StandupMode, m: Measurements, cfg: StandupConfig) -> bool:
+    """Every condition of phase.exit (phases.Guard) holds for mode at m."""
+    guard: Guard = phase.exit
+    k = mode.state - 1
+    dwell = m.t - mode.entry_times_s[k]
+    g = mode.guards
+    if dwell < guard.min_time_s:
+        return False
+    if guard.asked and not (cfg.trigger == "time" or g.hands_pulled.on or m.stand_up):
+        return False
+    if guard.segment_done and not (
+        m.psi - mode.psi_entry >= mode.segment_psi or not any(mode.delta_m)
+    ):
+        return False
+    if guard.unloaded and dwell < phase.unload_s:
+        return False
+    if guard.feet_force_N is not None and not g.feet_loaded[k].on:
+        return False
+    if guard.each_foot_force_N is not None and not g.each_foot_loaded[k].on:
+        return False
+    ahead = guard.com_ahead_of_heels_m
+    return ahead is None or m.com_W[0] >= m.heel_x + ahead
+
+
+def _released(phase: Phase) -> list[int]:
+    """The entries of seat_loads that phase releases."""
+    return [i for i, pads in enumerate(SEAT_LOADS) if pads in phase.unload]
+
+
+def _sit_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMode:
+    """Back to state 1: a pull against the stand-up waits seated (the paper: psi = t,
+    nothing advances). The state-1 segment starts where the reference is now (no jump)
+    and returns to where the CoM sat at the start, over phases.seated.segment_psi; state
+    1's balancing time runs again from now, and its exit waits for the return. Held where
+    it was instead, each later forward segment ended its offset further on and the
+    robot stood up past its toes (docs/design.md, "A pull against the stand-up")."""
     x_now = path(mode.segment(), m.psi)[0]
     entry = [m.t] + [math.nan] * (N_STATES - 1)
     return dataclasses.replace(
@@ -247,57 +258,49 @@ def _reseat(mode: StandupMode, m: Measurements, cfg: StandupConfig) -> StandupMo
         state=1,
         entry_times_s=tuple(entry),
         psi_entry=m.psi,
-        segment_psi=cfg.segment_psi[0],
+        segment_psi=table.seated.segment_psi,
         x_start_m=tuple(float(v) for v in x_now),
         delta_m=tuple(float(a - b) for a, b in zip(mode.x_seated_m, x_now, strict=True)),
-        state3_end_m=(math.nan, math.nan, math.nan),
+        resume_end_m=_NAN3,
+        sat_back=True,
     )
 
 
-def _back_to_state_2(mode: StandupMode, m: Measurements) -> StandupMode:
-    """From state 3, the thighs unloading, back to state 2 under a hindering pull: the
-    thighs are planned seated again (they carry what the chair gives) and the reference
-    stops where the state-3 segment had brought it (psi = t, nothing advances). Once the
-    pull has stopped, state 2's guards (calm among them) go on to state 3 again, whose
-    segment then ends where the interrupted one would have. Holding state 3 instead, the
-    thighs went on unloading under the pull and a 15 N per hand pull caught with them at
-    70-90 % of their load tipped the robot back; sat back into state 1 from there, it
-    ended up further forward on the chair and its next attempt fell back (measured)."""
+def _step_back(mode: StandupMode, m: Measurements) -> StandupMode:
+    """Back to the previous phase while this one's pads unload: they are seated again
+    (they carry what the chair gives) and the reference stops where it is (psi = t,
+    nothing advances). Once the pull has stopped, the previous phase's guard (calm among
+    them) enters this phase again, whose segment then ends where the interrupted one
+    would have (docs/design.md, "A pull against the stand-up")."""
     x_now = path(mode.segment(), m.psi)[0]
     entry = list(mode.entry_times_s)
-    entry[2] = math.nan
+    entry[mode.state - 1] = math.nan
     return dataclasses.replace(
         mode,
-        state=2,
+        state=mode.state - 1,
         entry_times_s=tuple(entry),
         psi_entry=m.psi,
         segment_psi=1.0,
         x_start_m=tuple(float(v) for v in x_now),
         delta_m=(0.0, 0.0, 0.0),
-        state3_end_m=tuple(float(v) for v in mode.segment_end()),
+        resume_end_m=tuple(float(v) for v in mode.segment_end()),
     )
 
 
-def _enter(mode: StandupMode, state: int, m: Measurements, cfg: StandupConfig) -> StandupMode:
-    # State 1 holds its start, so its "end" is x_start; later segments have
-    # finished (segment_done), so they end at x_start + delta exactly.
+def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) -> StandupMode:
+    """state's phase entered: its segment starts where the previous one ended (that one
+    is done, or holds still), at the CoM's height where the phase says so (bumpless: a
+    stiffer height gain would otherwise see the lean's 1-3 cm drop as a step), toward its
+    displacement, its absolute height, or where a step back left it to end."""
+    phase = table.phase(state)
     x_start = mode.segment_end()
-    if state == 3:
-        # Bumpless: state 3 stiffens the CoM's height (com_kp_standing: 30 against 5
-        # seated), and the forward lean of state 2 leaves the CoM 1-3 cm below the
-        # seated height. Kept, that error became a step in the demanded lift that
-        # unloaded the thighs at once (48 -> 20 N in 20 ms, measured) and they landed
-        # again; the segment starts at the CoM's height instead, and state 4 rises
-        # from there.
+    if phase.start_at_com_height:
         x_start[2] = float(m.com_W[2])
-    if state == 2:
-        delta = np.array(cfg.state2_com_delta_m)
-    elif state == 3:
-        delta = np.array(cfg.state3_com_delta_m)
-        if not math.isnan(mode.state3_end_m[0]):  # once more, after a hindering pull
-            delta[:2] = np.array(mode.state3_end_m[:2]) - x_start[:2]
-    else:
-        delta = np.array([0.0, 0.0, cfg.standing_com_height_m - x_start[2]])
+    delta = np.array(phase.com_delta_m, dtype=float)
+    if phase.com_height_m is not None:
+        delta[2] = phase.com_height_m - x_start[2]
+    if mode.stepped_back():
+        delta[:2] = np.array(mode.resume_end_m[:2]) - x_start[:2]
     entry = list(mode.entry_times_s)
     entry[state - 1] = m.t
     return dataclasses.replace(
@@ -305,57 +308,59 @@ def _enter(mode: StandupMode, state: int, m: Measurements, cfg: StandupConfig) -
         state=state,
         entry_times_s=tuple(entry),
         psi_entry=m.psi,
-        segment_psi=cfg.segment_psi[state - 2],
+        segment_psi=phase.segment_psi,
         x_start_m=tuple(float(v) for v in x_start),
         delta_m=tuple(float(v) for v in delta),
-        state3_end_m=(math.nan, math.nan, math.nan),
+        resume_end_m=_NAN3,
     )
 
 
-def seat_scale(mode: StandupMode, t: float, cfg: StandupConfig) -> float:
-    """1 while seated; from state 3 it ramps to 0 over seat_release_s."""
-    if mode.state < 3:
-        return 1.0
-    if cfg.seat_release_s <= 0:
-        return 0.0
-    return max(0.0, 1.0 - (t - mode.entry_times_s[2]) / cfg.seat_release_s)
+# The seat pads, as seat_loads orders them, and their pad group (phases.SEAT_PADS).
+SEAT_LOADS = ("buttocks", "thighs", "thighs")
 
 
-def seat_unloading(mode: StandupMode, t: float, cfg: StandupConfig) -> np.ndarray:
-    """What is left of the load of the buttocks (seat contact) and of each thigh, as a
-    fraction of their load when their unloading began; NaN while the pad is seated (the
-    controller's choice). Smoothstep from 1 to 0: the buttocks over seat_unload_s from
-    state 2 (the pelvis pitching forward about the hips lifts them), the thighs over
-    seat_release_s from state 3 (smoothstep of seat_scale)."""
-    fractions = np.full(3, math.nan)
-    if mode.state >= 2:
-        if cfg.seat_unload_s <= 0:
-            fractions[0] = 0.0
-        else:
-            fractions[0] = smoothstep(1.0 - (t - mode.entry_times_s[1]) / cfg.seat_unload_s)
-    if mode.state >= 3:
-        fractions[1:] = smoothstep(seat_scale(mode, t, cfg))
-    return fractions
+def seat_loads(mode: StandupMode, t: float, table: PhaseTable) -> np.ndarray:
+    """What is left of the load of the buttocks and of each thigh (SEAT_LOADS), as a
+    fraction of their load when their release began; NaN while the pad is seated. A pad
+    group is released from the entry of the phase that lists it in unload (from then on,
+    until the robot is back in an earlier phase), smoothstep from 1 to 0 over its
+    unload_s."""
+    loads = np.full(len(SEAT_LOADS), math.nan)
+    for pads in SEAT_PADS:
+        state = table.unloading_phase(pads)
+        if state is None or mode.state < state:
+            continue
+        over_s = table.phase(state).unload_s
+        left = (
+            0.0 if over_s <= 0 else smoothstep(1.0 - (t - mode.entry_times_s[state - 1]) / over_s)
+        )
+        loads[[i for i, name in enumerate(SEAT_LOADS) if name == pads]] = left
+    return loads
 
 
 class StandupStateMachine(LeafSystem):
-    """Periodic (update_period_s) state machine with the mode as abstract state.
+    """Periodic (standup.update_period_s) state machine with the mode as abstract state.
 
-    Inputs: psi (1), com_W (3), heel_x_W (1), pad_forces_W (3 per pad, rows of
-    the soles given as sole_rows = (left, right)), hand_wrenches_W (12), and
+    Inputs: psi (1), com_W (3), heel_x_W (1), pad_forces_W (3 per pad, rows of the soles
+    given as sole_rows = (left, right)), hand_wrenches_W (12, payloads.HAND_WRENCHES), and
     stand_up (1; > 0.5: go; unconnected: never), which only the live helper has.
-    Outputs: standup_state (1), segment (8: [psi_entry, T, x_start, delta]),
-    contact_plan (6: [state, seat_scale, feet_scale, then what is left of the
-    load of the seat, left thigh, right thigh (seat_unloading; NaN: seated)]),
-    entry_times_s (4, NaN for states not reached), held_back (2: [a pull against
-    the stand-up holds it (1/0), the time it has waited so far, s]).
+    Outputs: mode (abstract StandupMode), standup_state (1), advances (1: the phase lets
+    psi advance), segment (payloads.SEGMENT), entry_times_s (4, NaN for states not
+    reached), held_back (2: [a pull against the stand-up holds it (1/0), the time it has
+    waited so far, s]).
     """
 
-    PLAN_SIZE = 6
-
-    def __init__(self, config: StandupConfig, n_pads: int, sole_rows: tuple[int, int]):
+    def __init__(
+        self,
+        config: StandupConfig,
+        table: PhaseTable,
+        n_pads: int,
+        sole_rows: tuple[int, int],
+    ):
         super().__init__()
         self._cfg = config
+        self._table = table
+        self._advances = [float(phase.advances) for phase in table]
         self._sole_rows = sole_rows
         self._mode_index = self.DeclareAbstractState(Value[object](StandupMode()))
         self._psi = self.DeclareVectorInputPort("psi", 1)
@@ -367,37 +372,30 @@ class StandupStateMachine(LeafSystem):
         self.DeclareInitializationUnrestrictedUpdateEvent(self._Initialize)
         self.DeclarePeriodicUnrestrictedUpdateEvent(config.update_period_s, 0.0, self._Update)
         mode_only = {self.abstract_state_ticket(self._mode_index)}
-        self.DeclareVectorOutputPort(
-            "standup_state", 1, self._CalcState, prerequisites_of_calc=mode_only
+        self.DeclareAbstractOutputPort(
+            "mode", lambda: Value[object](StandupMode()), self._CalcMode, mode_only
         )
-        self.DeclareVectorOutputPort(
-            "segment", SEGMENT_SIZE, self._CalcSegment, prerequisites_of_calc=mode_only
-        )
+        vectors = {
+            "standup_state": (1, self._CalcState),
+            "advances": (1, self._CalcAdvances),
+            "segment": (SEGMENT.size, self._CalcSegment),
+            "entry_times_s": (N_STATES, self._CalcEntryTimes),
+            "held_back": (2, self._CalcHeldBack),
+        }
+        for name, (size, calc) in vectors.items():
+            self.DeclareVectorOutputPort(name, size, calc, prerequisites_of_calc=mode_only)
         self.DeclareVectorOutputPort(
             "contact_plan",
-            self.PLAN_SIZE,
+            6,
             self._CalcContactPlan,
-            prerequisites_of_calc={
-                self.abstract_state_ticket(self._mode_index),
-                self.time_ticket(),
-            },
-        )
-        self.DeclareVectorOutputPort(
-            "entry_times_s", N_STATES, self._CalcEntryTimes, prerequisites_of_calc=mode_only
-        )
-        # [hindered (1/0), time held back so far, s]
-        self.DeclareVectorOutputPort(
-            "held_back", 2, self._CalcHeldBack, prerequisites_of_calc=mode_only
+            prerequisites_of_calc=mode_only | {self.time_ticket()},
         )
 
     def mode(self, context: Context) -> StandupMode:
         return context.get_abstract_state(self._mode_index).get_value()
 
     def _Initialize(self, context: Context, state: State) -> None:
-        mode = initial_mode(self._com.Eval(context))
-        mode = dataclasses.replace(
-            mode, entry_times_s=(context.get_time(),) + (math.nan,) * (N_STATES - 1)
-        )
+        mode = initial_mode(self._com.Eval(context), context.get_time())
         state.get_mutable_abstract_state(self._mode_index).set_value(mode)
 
     def _measure(self, context: Context) -> Measurements:
@@ -415,28 +413,36 @@ class StandupStateMachine(LeafSystem):
         )
 
     def _Update(self, context: Context, state: State) -> None:
-        mode = self.mode(context)
-        new = next_mode(mode, self._measure(context), self._cfg)
+        new = next_mode(self.mode(context), self._measure(context), self._cfg, self._table)
         state.get_mutable_abstract_state(self._mode_index).set_value(new)
+
+    def _CalcMode(self, context: Context, output: Value) -> None:
+        output.set_value(self.mode(context))
 
     def _CalcState(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, self.mode(context).state)
 
+    def _CalcAdvances(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self._advances[self.mode(context).state - 1])
+
     def _CalcSegment(self, context: Context, output: BasicVector) -> None:
         output.SetFromVector(self.mode(context).segment())
-
-    def _CalcContactPlan(self, context: Context, output: BasicVector) -> None:
-        mode = self.mode(context)
-        t = context.get_time()
-        output.SetFromVector(
-            np.r_[
-                mode.state, seat_scale(mode, t, self._cfg), 1.0, seat_unloading(mode, t, self._cfg)
-            ]
-        )
 
     def _CalcHeldBack(self, context: Context, output: BasicVector) -> None:
         mode = self.mode(context)
         output.SetFromVector([float(mode.guards.hindered.on), mode.held_back_s])
+
+    def _CalcContactPlan(self, context: Context, output: BasicVector) -> None:
+        mode = self.mode(context)
+        t = context.get_time()
+        loads = seat_loads(mode, t, self._table)
+        k = self._table.unloading_phase("thighs")
+        if mode.state < k:
+            scale = 1.0
+        else:
+            over = self._table.phase(k).unload_s
+            scale = 0.0 if over <= 0 else max(0.0, 1.0 - (t - mode.entry_times_s[k - 1]) / over)
+        output.SetFromVector(np.r_[mode.state, scale, 1.0, loads])
 
     def _CalcEntryTimes(self, context: Context, output: BasicVector) -> None:
         output.SetFromVector(np.array(self.mode(context).entry_times_s))

@@ -173,7 +173,7 @@ def test_the_readme_scenario_example_parses():
     text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
     example = text[text.index("## Scenarios") :].split("```yaml\n", 1)[1].split("```", 1)[0]
     scenario = parse_scenario(example)
-    assert scenario.standup.standing_com_height_m == 0.575
+    assert scenario.phases.rise.com_height_m == 0.575
     assert scenario.human.reactive.guide == "path"
 
 
@@ -217,7 +217,8 @@ def test_every_rule_names_a_key():
 # joint limits clamp the posture targets; a name the model lacks is an error at build),
 # the chair file (checked to exist), lead_max_m (checked against lead_min_m).
 UNBOUNDED = (
-    r"robot\.model|chair\.file|initial\.joints_rad\..*|controller\.posture_state\d_rad\..*"
+    r"robot\.model|chair\.file|initial\.joints_rad\..*|phases\.\w+\.posture_rad\..*"
+    r"|phases\.\w+\.base_pitch_rad"
     r"|controller\.seat_hinge_joints\[\d+\]|perturbation\.pushes\[\d+\]\.body"
     r"|human\.reactive\.lead_max_m"
 )

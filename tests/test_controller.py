@@ -20,6 +20,7 @@ from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
 from drake_standup.control.references import helpful_force
 from drake_standup.control.terms import RobotKinematics
 from drake_standup.controller import WholeBodyController
+from drake_standup.phases import PhaseTable
 from drake_standup.scene import add_scene, set_seated_state
 
 G = 9.81
@@ -366,7 +367,7 @@ def test_contacts_cancel_all_but_the_helpful_pull(scene, moving):
     solution = controller.CalcTick(context).solution
     assert solution.ok
     mass = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
-    kd_x = 2.0 * config.com_damping_ratio * np.sqrt(config.com_kp_seated_per_s2[0])
+    kd_x = 2.0 * config.com_damping_ratio * np.sqrt(PhaseTable().seated.com_kp_per_s2[0])
     xddot_x = kd_x * xd_dot[0]  # xddot* = xd_ddot - K_D (0 - xd_dot) - K_P 0
     contacts = solution.F_W[:, 3:].sum(axis=0)
     expected = np.array([mass * xddot_x - (0.0 if moving else 30.0), 0.0, mass * G - 30.0])
@@ -500,12 +501,12 @@ def test_ports_and_config(scene):
     assert controller.GetOutputPort("actuation").size() == plant.num_actuators()
     assert controller.GetOutputPort("diagnostics").size() == len(controller.DIAGNOSTICS)
     config = yaml_load_typed(
-        schema=ControllerConfig, data="qp_solver: clarabel\ncom_kp_seated_per_s2: [1, 2, 3]\n"
+        schema=ControllerConfig, data="qp_solver: clarabel\nposture_weight: 0.5\n"
     )
-    assert config.qp_solver == "clarabel" and config.com_kp_seated_per_s2 == [1.0, 2.0, 3.0]
-    assert config.posture_state4_rad == ControllerConfig().posture_state4_rad
-    with pytest.raises(ValueError, match="posture_state2_rad"):
-        _controller(scene, posture_state2_rad={"no_such_joint": 0.0})
+    assert config.qp_solver == "clarabel" and config.posture_weight == 0.5
+    assert config.stance_posture_weight_by_joint == (
+        ControllerConfig().stance_posture_weight_by_joint
+    )
 
 
 @pytest.mark.parametrize("scale", [0.85, 1.15])

@@ -171,7 +171,7 @@ def _quick(trigger: str = "hands") -> Scenario:
     """The assisted scenario with a short balance time: the stand-up may start at 0.2 s."""
     scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
     scenario.standup.trigger = trigger
-    scenario.standup.balance_time_s = 0.2
+    scenario.phases.seated.exit.min_time_s = 0.2
     return scenario
 
 

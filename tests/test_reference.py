@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from drake_standup.config import StandupConfig
+from drake_standup.phases import PhaseTable
 from drake_standup.reference import CoMReferenceGenerator, min_jerk, path
 from drake_standup.state_machine import Measurements, initial_mode, next_mode
 
@@ -80,6 +81,7 @@ def test_path_is_continuous_in_value_and_slope_across_switches():
     """Drive the state machine through states 1-4 with psi = 1.3 t and check
     x_d and d_psi x_d just before and after every switch."""
     cfg = StandupConfig(trigger="time")
+    table = PhaseTable()
     com0 = np.array([0.06, 0.0, 0.38])
     mode = initial_mode(com0)
     segments = [mode.segment()]
@@ -94,7 +96,7 @@ def test_path_is_continuous_in_value_and_slope_across_switches():
             foot_fz_N=(200.0, 200.0),
             hand_fx_N=(0.0, 0.0),
         )
-        new = next_mode(mode, m, cfg)
+        new = next_mode(mode, m, cfg, table)
         if new.state != mode.state:
             before = path(mode.segment(), m.psi)
             after = path(new.segment(), m.psi)
@@ -110,7 +112,8 @@ def test_path_is_continuous_in_value_and_slope_across_switches():
     assert len(segments) == 4
     # The last segment ends at the standing height.
     end = path(segments[-1], 1e9)[0]
-    assert end[2] == pytest.approx(cfg.standing_com_height_m)
+    assert end[2] == pytest.approx(table.rise.com_height_m)
     np.testing.assert_allclose(
-        end[:2], (com0 + np.array(cfg.state2_com_delta_m) + np.array(cfg.state3_com_delta_m))[:2]
+        end[:2],
+        (com0 + np.array(table.forward.com_delta_m) + np.array(table.lift_off.com_delta_m))[:2],
     )

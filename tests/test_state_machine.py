@@ -12,21 +12,39 @@ import pytest
 from pydrake.systems.analysis import Simulator
 
 from drake_standup.config import StandupConfig
+from drake_standup.phases import PhaseTable
 from drake_standup.state_machine import (
     GuardSignals,
     Measurements,
     SchmittTrigger,
     StandupStateMachine,
+    _enter,
     initial_mode,
     next_mode,
-    seat_scale,
-    seat_unloading,
+    seat_loads,
     update_guards,
 )
 
-# The authors' dwell times (SPEC 3; our defaults leave the dwell to psi), so
-# the dwell guards are exercised too.
-CFG = StandupConfig(min_time_state2_s=1.5, min_time_state3_s=0.5)
+CFG = StandupConfig()
+
+
+def _table(**exits) -> PhaseTable:
+    """The default phase table with the authors' dwell times (SPEC 3; our defaults leave
+    the dwell to psi), so the dwell guards are exercised too; exits: more of it, as
+    {phase: {field: value}} (a field of Phase, or exit.<field> of its Guard)."""
+    table = PhaseTable()
+    table.forward.exit.min_time_s = 1.5
+    table.lift_off.exit.min_time_s = 0.5
+    for name, fields in exits.items():
+        phase = getattr(table, name)
+        for key, value in fields.items():
+            target, _, leaf = key.rpartition(".")
+            setattr(phase.exit if target else phase, leaf, value)
+    return table
+
+
+TABLE = _table()
+SEATED, FORWARD, LIFT_OFF = TABLE.seated, TABLE.forward, TABLE.lift_off
 COM0 = np.array([0.06, 0.0, 0.38])
 AHEAD = np.array([0.30, 0.0, 0.40])  # CoM far in front of the heels
 
@@ -35,33 +53,27 @@ def _m(t, psi=None, com=AHEAD, heel_x=0.1, feet=(200.0, 200.0), hands=(20.0, 20.
     return Measurements(t, t if psi is None else psi, com, heel_x, feet, hands)
 
 
-def _settled(mode, m, cfg=CFG):
+def _settled(mode, m, cfg=CFG, table=TABLE):
     """mode with its guards' signals as if m's forces had been measured for the last
     second (every 10 ms): filters settled, triggers past their dwell."""
     g = GuardSignals()
     for k in range(100, 0, -1):
-        g = update_guards(g, dataclasses.replace(m, t=m.t - 0.01 * k), cfg)
+        g = update_guards(g, dataclasses.replace(m, t=m.t - 0.01 * k), cfg, table)
     return dataclasses.replace(mode, guards=g)
 
 
-def _next(mode, m, cfg=CFG):
+def _next(mode, m, cfg=CFG, table=TABLE):
     """next_mode on a mode whose guards have settled on m's forces: the thresholds, as if
     the forces had held long enough."""
-    return next_mode(_settled(mode, m, cfg), m, cfg)
+    return next_mode(_settled(mode, m, cfg, table), m, cfg, table)
 
 
-def _in_state(state: int, t_entry: float, cfg=CFG):
+def _in_state(state: int, t_entry: float, table=TABLE):
     """A mode that entered `state` at t_entry with psi = t_entry."""
     mode = initial_mode(COM0)
     for k in range(2, state + 1):
-        mode = _force_enter(mode, k, t_entry, cfg)
+        mode = _enter(mode, k, _m(t_entry), table)
     return mode
-
-
-def _force_enter(mode, state, t, cfg):
-    from drake_standup.state_machine import _enter
-
-    return _enter(mode, state, _m(t), cfg)
 
 
 def test_1_to_2_needs_balance_time_and_both_hands_over_threshold():
@@ -83,10 +95,10 @@ def test_1_to_2_with_time_trigger_ignores_hands():
 
 def test_2_to_3_guards():
     mode = _in_state(2, 3.0)
-    t_ok = 3.0 + CFG.min_time_state2_s
-    thr = CFG.feet_force_2to3_N
+    t_ok = 3.0 + FORWARD.exit.min_time_s
+    thr = FORWARD.exit.feet_force_N
     heel = 0.1
-    com_ok = np.array([heel + CFG.com_ahead_of_heels_m, 0.0, 0.4])
+    com_ok = np.array([heel + FORWARD.exit.com_ahead_of_heels_m, 0.0, 0.4])
     ok = {"feet": (thr / 2 + 1e-9, thr / 2 + 1e-9), "com": com_ok, "heel_x": heel}
     assert _next(mode, _m(t_ok, **ok), CFG).state == 3  # all at their thresholds
     assert _next(mode, _m(t_ok - 1e-6, **ok), CFG).state == 2  # dwell
@@ -99,8 +111,8 @@ def test_2_to_3_guards():
 
 def test_3_to_4_needs_each_foot():
     mode = _in_state(3, 5.0)
-    t_ok = 5.0 + CFG.min_time_state3_s
-    thr = CFG.foot_force_3to4_N
+    t_ok = 5.0 + LIFT_OFF.exit.min_time_s
+    thr = LIFT_OFF.exit.each_foot_force_N
     assert _next(mode, _m(t_ok, feet=(thr + 1e-9, thr + 1e-9)), CFG).state == 4
     assert _next(mode, _m(t_ok, feet=(thr, 500.0)), CFG).state == 3
     assert _next(mode, _m(t_ok, feet=(500.0, thr)), CFG).state == 3
@@ -123,22 +135,13 @@ def test_never_skips_a_state_even_when_every_guard_holds():
     assert states == [1, 2, 3, 4, 4, 4]
 
 
-def test_seat_release_ramp():
-    mode = _in_state(3, 5.0)
-    assert seat_scale(_in_state(2, 3.0), 9.0, CFG) == 1.0
-    assert seat_scale(mode, 5.0, CFG) == 1.0
-    assert seat_scale(mode, 5.0 + CFG.seat_release_s / 4, CFG) == pytest.approx(0.75)
-    assert seat_scale(mode, 5.0 + CFG.seat_release_s, CFG) == 0.0
-    assert seat_scale(mode, 50.0, CFG) == 0.0
-
-
 def test_leaf_system_switches_on_its_update_grid():
     """Fixed synthetic inputs with trigger 'time': the system enters 2 at the
     first update at or after balance_time_s, then 3 after min_time_state2_s,
     then 4 after min_time_state3_s, exactly on the update grid."""
     cfg = dataclasses.replace(CFG, trigger="time", update_period_s=0.01)
     n_pads = 5
-    system = StandupStateMachine(cfg, n_pads=n_pads, sole_rows=(0, 1))
+    system = StandupStateMachine(cfg, TABLE, n_pads=n_pads, sole_rows=(0, 1))
     context = system.CreateDefaultContext()
     pads = np.zeros((n_pads, 3))
     pads[0, 2] = pads[1, 2] = 200.0
@@ -156,17 +159,17 @@ def test_leaf_system_switches_on_its_update_grid():
         t = round(t + 0.001, 9)
         simulator.AdvanceTo(t)
     entries = system.GetOutputPort("entry_times_s").Eval(context)
-    t2 = cfg.balance_time_s
-    t3 = t2 + max(cfg.min_time_state2_s, cfg.segment_psi[0])
-    t4 = t3 + max(cfg.min_time_state3_s, cfg.segment_psi[1])
+    t2 = SEATED.exit.min_time_s
+    t3 = t2 + max(FORWARD.exit.min_time_s, FORWARD.segment_psi)
+    t4 = t3 + max(LIFT_OFF.exit.min_time_s, LIFT_OFF.segment_psi)
     np.testing.assert_allclose(entries, [0.0, t2, t3, t4], atol=cfg.update_period_s + 1e-9)
     assert system.GetOutputPort("standup_state").Eval(context)[0] == 4
-    plan = system.GetOutputPort("contact_plan").Eval(context)
-    assert plan[0] == 4 and plan[1] == 0.0  # seat released by t = 8 s
+    loads = seat_loads(system.GetOutputPort("mode").Eval(context), 8.0, TABLE)
+    np.testing.assert_array_equal(loads, 0.0)  # the seat released by t = 8 s
 
 
 def test_entry_times_are_nan_until_reached():
-    system = StandupStateMachine(CFG, n_pads=5, sole_rows=(0, 1))
+    system = StandupStateMachine(CFG, TABLE, n_pads=5, sole_rows=(0, 1))
     context = system.CreateDefaultContext()
     entries = system.GetOutputPort("entry_times_s").Eval(context)
     assert entries[0] == 0.0 and all(math.isnan(e) for e in entries[1:])
@@ -190,13 +193,13 @@ def test_noisy_force_around_the_threshold_switches_once():
     t = np.arange(0.0, 3.0, 0.01)
     mean = np.interp(t, [0.0, 3.0], [100.0, 220.0])
     total = mean + rng.uniform(-40.0, 40.0, len(t))
-    thr = CFG.feet_force_2to3_N
+    thr = FORWARD.exit.feet_force_N
     raw_crossings = np.count_nonzero(np.diff((total > thr).astype(int)) != 0)
     assert raw_crossings > 10  # the noise would flip a bare threshold
     g, on = GuardSignals(), []
     for m in _feet_trace(t, total):
-        g = update_guards(g, m, CFG)
-        on.append(g.feet_loaded.on)
+        g = update_guards(g, m, CFG, TABLE)
+        on.append(g.feet_loaded[1].on)
     switches = np.flatnonzero(np.diff(np.array(on, dtype=int)))
     assert len(switches) == 1 and on[-1]
     # ... near where the mean crosses the threshold (1.25 s), within the filter's lag
@@ -205,22 +208,22 @@ def test_noisy_force_around_the_threshold_switches_once():
 
 
 def test_dwell_rejects_a_short_spike_and_accepts_a_held_load():
-    thr = CFG.feet_force_2to3_N
+    thr = FORWARD.exit.feet_force_N
     t = np.arange(0.0, 1.0, 0.01)
     # A 300 N spike for 20 ms: the filtered force passes 150 N (166 N), but not for the
     # dwell.
     spike = np.where((t >= 0.5) & (t < 0.52), 300.0, 100.0)
     g = GuardSignals()
     for m in _feet_trace(t, spike):
-        g = update_guards(g, m, CFG)
-        assert not g.feet_loaded.on
+        g = update_guards(g, m, CFG, TABLE)
+        assert not g.feet_loaded[1].on
     # Held: on at the first update at least guard_dwell_s after the filtered force
     # passed the threshold, i.e. after the filter's lag tau ln(2) (step 100 -> 200 N).
     held = np.where(t >= 0.5, 200.0, 100.0)
     g, t_on = GuardSignals(), None
     for m in _feet_trace(t, held):
-        g = update_guards(g, m, CFG)
-        if g.feet_loaded.on and t_on is None:
+        g = update_guards(g, m, CFG, TABLE)
+        if g.feet_loaded[1].on and t_on is None:
             t_on = m.t
     lag = CFG.force_filter_time_constant_s * math.log((200.0 - 100.0) / (200.0 - thr))
     assert t_on == pytest.approx(0.5 + lag + CFG.guard_dwell_s, abs=0.011)
@@ -247,9 +250,9 @@ def test_schmitt_trigger_hysteresis():
 
 def test_filter_is_first_order():
     """A step seen every 10 ms: the filtered force after time t is 1 - exp(-t / tau)."""
-    g = update_guards(GuardSignals(), _m(0.0, feet=(0.0, 0.0)), CFG)
+    g = update_guards(GuardSignals(), _m(0.0, feet=(0.0, 0.0)), CFG, TABLE)
     for k in range(1, 11):
-        g = update_guards(g, _m(0.01 * k, feet=(100.0, 100.0)), CFG)
+        g = update_guards(g, _m(0.01 * k, feet=(100.0, 100.0)), CFG, TABLE)
     expected = 100.0 * (1.0 - math.exp(-0.1 / CFG.force_filter_time_constant_s))
     assert g.foot_fz_N[0] == pytest.approx(expected)
 
@@ -258,25 +261,26 @@ def test_filter_is_first_order():
 
 
 def test_seat_unloading_plan():
-    cfg = CFG
-    assert np.isnan(seat_unloading(_in_state(1, 0.0), 1.0, cfg)).all()
+    """The phase table's release: the buttocks from state 2 over its unload_s, the thighs
+    from state 3 over theirs, smoothstep from 1 to 0 (3 r^2 - 2 r^3 of the time left)."""
+    assert np.isnan(seat_loads(_in_state(1, 0.0), 1.0, TABLE)).all()
     mode = _in_state(2, 3.0)
-    half = 3.0 + cfg.seat_unload_s / 2
-    np.testing.assert_allclose(seat_unloading(mode, 3.0, cfg)[0], 1.0)
-    np.testing.assert_allclose(seat_unloading(mode, half, cfg)[0], 0.5)  # smoothstep
-    assert seat_unloading(mode, 3.0 + cfg.seat_unload_s, cfg)[0] == 0.0
-    assert np.isnan(seat_unloading(mode, 4.0, cfg)[1:]).all()  # thighs still seated
+    half = 3.0 + FORWARD.unload_s / 2
+    np.testing.assert_allclose(seat_loads(mode, 3.0, TABLE)[0], 1.0)
+    np.testing.assert_allclose(seat_loads(mode, half, TABLE)[0], 0.5)  # smoothstep
+    assert seat_loads(mode, 3.0 + FORWARD.unload_s, TABLE)[0] == 0.0
+    assert np.isnan(seat_loads(mode, 4.0, TABLE)[1:]).all()  # thighs still seated
     mode = _in_state(3, 5.0)
-    quarter = 5.0 + cfg.seat_release_s / 4  # seat_scale 0.75
-    np.testing.assert_allclose(seat_unloading(mode, quarter, cfg)[1:], 0.75**2 * 1.5)
-    np.testing.assert_allclose(seat_unloading(mode, 5.0 + cfg.seat_release_s, cfg), 0.0)
+    quarter = 5.0 + LIFT_OFF.unload_s / 4  # seat_scale 0.75
+    np.testing.assert_allclose(seat_loads(mode, quarter, TABLE)[1:], 0.75**2 * 1.5)
+    np.testing.assert_allclose(seat_loads(mode, 5.0 + LIFT_OFF.unload_s, TABLE), 0.0)
 
 
 def test_3_to_4_waits_for_the_release():
-    cfg = dataclasses.replace(CFG, min_time_state3_s=0.0, seat_release_s=0.8)
-    mode = _in_state(3, 5.0, cfg)
-    assert _next(mode, _m(5.79, psi=20.0), cfg).state == 3
-    assert _next(mode, _m(5.801, psi=20.0), cfg).state == 4
+    table = _table(lift_off={"exit.min_time_s": 0.0, "unload_s": 0.8})
+    mode = _in_state(3, 5.0, table)
+    assert _next(mode, _m(5.79, psi=20.0), table=table).state == 3
+    assert _next(mode, _m(5.801, psi=20.0), table=table).state == 4
 
 
 def test_state_3_starts_at_the_com_height():
@@ -284,7 +288,7 @@ def test_state_3_starts_at_the_com_height():
     the state-2 segment), and state 4 rises from there to the standing height."""
     mode = _in_state(2, 3.0)
     com = np.array([0.3, 0.01, 0.355])
-    new = _next(mode, _m(3.0 + CFG.min_time_state2_s, com=com, feet=(200.0, 200.0)))
+    new = _next(mode, _m(3.0 + FORWARD.exit.min_time_s, com=com, feet=(200.0, 200.0)))
     assert new.state == 3
     assert new.x_start_m[2] == pytest.approx(0.355)
     np.testing.assert_allclose(new.x_start_m[:2], mode.segment_end()[:2])
@@ -314,10 +318,10 @@ def test_a_backward_pull_with_the_thighs_on_the_chair_sits_back_without_a_jump(s
     again; state 2 waits for the return and then starts from the seated CoM, so that it
     ends where the first attempt's would have."""
     cfg = dataclasses.replace(CFG, trigger="time")
-    mode = _in_state(state, 3.0, cfg)
+    mode = _in_state(state, 3.0)
     assert mode.x_seated_m == tuple(COM0)
     # A tenth into the thighs' release: they carry 97 % of their load (smoothstep).
-    t = psi = 3.0 + 0.1 * min(cfg.seat_release_s, mode.segment_psi)
+    t = psi = 3.0 + 0.1 * min(LIFT_OFF.unload_s, mode.segment_psi)
     new = _next(mode, _m(t, psi=psi, hands=(-10.0, -10.0)), cfg)
     assert new.state == 1 and new.entry_times_s[0] == t
     assert all(math.isnan(e) for e in new.entry_times_s[1:])
@@ -327,7 +331,7 @@ def test_a_backward_pull_with_the_thighs_on_the_chair_sits_back_without_a_jump(s
     np.testing.assert_allclose(new.x_start_m, expected, atol=1e-12)
     np.testing.assert_allclose(new.segment_end(), COM0, atol=1e-12)
     # The balancing time has run but the return has not: still seated.
-    late = t + cfg.balance_time_s + 0.01
+    late = t + SEATED.exit.min_time_s + 0.01
     calm = (0.0, 0.0)
     assert _next(new, _m(late, psi=t + 0.5 * new.segment_psi, hands=calm), cfg).state == 1
     again = _next(new, _m(late, psi=t + new.segment_psi + 0.01, hands=calm), cfg)
@@ -344,9 +348,9 @@ def test_state_3_goes_back_onto_the_thighs_while_they_unload(into_release):
     pulled, however the guards read; once the pull has stopped for resume_after_s, state
     3 again, whose segment ends where the interrupted one was to end."""
     cfg = dataclasses.replace(CFG, trigger="time")
-    mode = _in_state(3, 5.0, cfg)
+    mode = _in_state(3, 5.0)
     end = mode.segment_end()
-    t = psi = 5.0 + into_release * cfg.seat_release_s
+    t = psi = 5.0 + into_release * LIFT_OFF.unload_s
     back = (-10.0, -10.0)
     feet = (500.0, 500.0)
     held = _next(mode, _m(t, psi=psi, feet=feet, hands=back), cfg)
@@ -356,7 +360,7 @@ def test_state_3_goes_back_onto_the_thighs_while_they_unload(into_release):
     x_held = np.array(mode.x_start_m) + s * np.array(mode.delta_m)
     np.testing.assert_allclose(held.x_start_m, x_held, atol=1e-12)
     assert held.delta_m == (0.0, 0.0, 0.0)
-    assert math.isnan(seat_unloading(held, t, cfg)[1])  # the thighs seated again
+    assert math.isnan(seat_loads(held, t, TABLE)[1])  # the thighs seated again
     later = t + 5.0  # still pulled: feet loaded, CoM ahead, segment done; still state 2
     assert _next(held, _m(later, psi=later, feet=feet, hands=back), cfg).state == 2
     held = dataclasses.replace(held, hindered_until_s=later)
@@ -373,8 +377,8 @@ def test_state_3_holds_once_the_thighs_are_off_the_chair():
     """After the thighs' release a backward pull no longer takes the robot back: state 3
     holds."""
     cfg = dataclasses.replace(CFG, trigger="time")
-    mode = _in_state(3, 5.0, cfg)
-    t = 5.0 + 1.01 * cfg.seat_release_s
+    mode = _in_state(3, 5.0)
+    t = 5.0 + 1.01 * LIFT_OFF.unload_s
     feet = (500.0, 500.0)
     held = _next(mode, _m(t, feet=feet, hands=(-10.0, -10.0)), cfg)
     assert held.state == 3 and held.x_start_m == mode.x_start_m
@@ -394,7 +398,7 @@ def test_the_stand_up_resumes_only_a_while_after_the_pull_stops():
 
 def test_state_3_goes_on_once_the_pull_has_stopped_for_a_while():
     mode = _in_state(3, 5.0)
-    t_ok = 5.0 + max(CFG.min_time_state3_s, CFG.seat_release_s) + 0.01
+    t_ok = 5.0 + max(LIFT_OFF.exit.min_time_s, LIFT_OFF.unload_s) + 0.01
     feet = (500.0, 500.0)
     mode = dataclasses.replace(mode, hindered_until_s=t_ok)
     assert _next(mode, _m(t_ok + 0.9 * CFG.resume_after_s, feet=feet, hands=(0.0, 0.0))).state == 3
@@ -408,7 +412,7 @@ def test_time_held_back_accumulates_while_hindered():
     for k in range(400):  # 4 s of updates every 10 ms: pulled back from 1 to 3 s
         t = 0.01 * k
         hands = (-10.0, -10.0) if 1.0 <= t < 3.0 else (0.0, 0.0)
-        mode = next_mode(mode, _m(t, hands=hands, com=COM0), cfg)
+        mode = next_mode(mode, _m(t, hands=hands, com=COM0), cfg, TABLE)
     # On once the filtered 20 N (first order, tau) crosses the threshold and the dwell
     # has passed, off likewise once it decays below guard_off_ratio of it: the 2 s
     # shifted by the difference of the two delays (within an update, 10 ms).
@@ -424,7 +428,7 @@ def test_stand_up_request_starts_like_the_pull_after_the_balance_time():
     pull: state 2 once the balance time is over, not before; without the request the
     robot stays seated; a pull against the stand-up still holds it."""
     mode = initial_mode(COM0)
-    t = CFG.balance_time_s
+    t = SEATED.exit.min_time_s
     asked = dataclasses.replace(_m(t, hands=(0.0, 0.0)), stand_up=True)
     assert _next(mode, asked).state == 2
     assert _next(mode, dataclasses.replace(asked, t=t - 0.1)).state == 1

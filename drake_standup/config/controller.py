@@ -5,39 +5,11 @@ from dataclasses import dataclass, field
 # The QP solvers the controller can use (control/qp.py: make_backend).
 QP_SOLVERS = ("daqp", "osqp", "clarabel")
 
-_POSTURE_JOINTS = (
-    "hip_pitch",
-    "hip_roll",
-    "knee",
-    "ankle_pitch",
-    "shoulder_pitch",
-    "shoulder_roll",
-    "shoulder_yaw",
-    "elbow",
-)
-
-
-def _posture(values: list[float]) -> dict[str, float]:
-    """SPEC 3 posture row [hip pitch, roll, knee, ankle pitch | shoulder pitch, roll, yaw,
-    elbow | torso pitch], both sides alike, as joint name -> rad."""
-    posture = {
-        f"{side}_{joint}": value
-        for side in "lr"
-        for joint, value in zip(_POSTURE_JOINTS, values[:8], strict=True)
-    }
-    posture["torso_pitch"] = values[8]
-    return posture
-
 
 @dataclass
 class ControllerConfig:
     """Gains, weights and contact limits of the whole-body controller."""
 
-    # CoM stiffness K_P (x, y, z) in states 1-2: a soft z lets the forward lean lower the
-    # CoM (SPEC 7: equal gains stalled it 4-7 cm short of the feet). 1/s^2.
-    com_kp_seated_per_s2: list[float] = field(default_factory=lambda: [60.0, 40.0, 5.0])
-    # CoM stiffness K_P in states 3-4: z raised to lift the robot (SPEC 7). 1/s^2.
-    com_kp_standing_per_s2: list[float] = field(default_factory=lambda: [60.0, 40.0, 30.0])
     # K_D = 2 zeta sqrt(K_P), critically damped (SPEC 7).
     com_damping_ratio: float = 1.0
     # Angular momentum: Ldot_ang* = -K_D L_ang - K_P int L_ang; K_P,ang = 1 (SPEC 3). 1/s^2.
@@ -66,18 +38,12 @@ class ControllerConfig:
     # shoulders at their limit (measured); the slack's use is reported.
     joint_limit_weight: float = 1.0e3
     # Base (root_link) orientation: upright at the yaw of the first tick, pitched forward
-    # by base_pitch_by_state_rad. The probe ended stooped 25 deg (SPEC 7). 1/s^2.
+    # by the phase's base_pitch_rad. The probe ended stooped 25 deg (SPEC 7). 1/s^2.
     base_orientation_kp_per_s2: float = 30.0
     # K_D = 2 zeta sqrt(K_P) for the base orientation.
     base_orientation_damping_ratio: float = 1.0
-    # Base pitch targets in states 1-4 (positive: forward): a human tilts the pelvis
-    # forward to bring the trunk over the feet, then stands upright (measured: an upright
-    # pelvis and the torso at its 1.22 rad limit left the CoM 3 cm short of the 2->3
-    # guard). rad.
-    base_pitch_by_state_rad: list[float] = field(default_factory=lambda: [0.0, 0.4, 0.3, 0.0])
-    # From this state on the seat lets the pelvis pitch about the hip axis (the mid-point
-    # of these joints' frames on root_link), the base orientation task steering it.
-    seat_hinge_from_state: int = 2
+    # A hinged seat (phases.py: seat_hold) lets the pelvis pitch about the hip axis, the
+    # mid-point of these joints' frames on root_link; the base orientation task steers it.
     seat_hinge_joints: list[str] = field(default_factory=lambda: ["l_hip_pitch", "r_hip_pitch"])
     # Task weights (QP cost, per squared residual): momentum (N, N m) dominates; posture
     # and base orientation (rad/s^2) act in what is left. The momentum rate is made by
@@ -140,23 +106,6 @@ class ControllerConfig:
     # with psi = t a 30 N pull otherwise carried the CoM 6 cm past the standing height onto
     # straight, locked knees (measured). m.
     help_max_lead_m: float = 0.02
-    # Posture references by joint name, states 2-4 (SPEC 3; torso pitch 1.0 in state 2 from
-    # the SPEC 7 probe: a deep lean). Joints not named hold the state-1 posture. rad.
-    posture_state2_rad: dict[str, float] = field(
-        default_factory=lambda: _posture(
-            [1.5402, 0.1594, -1.7365, -0.2814, -1.6455, 0.4363, 0.5862, 0.2473, 1.0]
-        )
-    )
-    posture_state3_rad: dict[str, float] = field(
-        default_factory=lambda: _posture(
-            [1.1097, 0.0122, -0.8365, -0.0714, -1.4615, 0.4363, 0.1545, 0.2018, 0.0611]
-        )
-    )
-    posture_state4_rad: dict[str, float] = field(
-        default_factory=lambda: _posture(
-            [0.2094, 0.1047, -0.1745, -0.0349, -1.6455, 0.4363, 0.5862, 0.2473, 0.0]
-        )
-    )
     # State 4 ends with the legs, not the CoM height: over the last part of the rise
     # (path progress from stance_from_progress to 1, smoothstep) the momentum task's
     # vertical row fades to stance_vertical_weight_scale of its weight and the state-4
@@ -167,10 +116,6 @@ class ControllerConfig:
     stance_vertical_weight_scale: float = 0.1
     # Integral gain on the CoM height error in the stance (control/references.py). 1/s^3.
     stance_height_ki_per_s3: float = 100.0
-    # Standup states in which the CoM target leans against the hands' pull so that the
-    # feet's CoP stays where it is without the pull (control/references.py: static_lean):
-    # standing, a 15 + 15 N pull per hand needed the CoP past the toes (measured).
-    lean_states: list[int] = field(default_factory=lambda: [3, 4])
     # Time constant of the lean's first-order filter: the pull's moment, not its jitter,
     # and a slow return when a helper lets go (at 0.3 s a robot leaning 6 cm into a
     # 15 N per hand backward pull staggered at the release and fell, measured). s.

@@ -19,8 +19,7 @@ def check_output_dir(path: Path | str, key: str = "--out") -> Path:
         raise ScenarioError(f"{key}: '{path}' is a file; accepted: a folder") from None
     except NotADirectoryError:
         raise ScenarioError(
-            f"{key}: '{path}' lies under a file; accepted: a folder path whose parents are "
-            "folders"
+            f"{key}: '{path}' lies under a file; accepted: a folder path whose parents are folders"
         ) from None
     except OSError as err:
         raise ScenarioError(

@@ -16,6 +16,7 @@ import yaml
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 
 from drake_standup.config.errors import ScenarioError
+from drake_standup.config.legacy import read_legacy
 from drake_standup.config.rules import _format, _nodes, _pattern, validate
 from drake_standup.config.scenario import DEFAULT_SCENARIO, Scenario
 from drake_standup.resources import find, shipped
@@ -76,6 +77,7 @@ def _load(raw: dict, defaults: Scenario) -> Scenario:
     """yaml_load_typed of raw (plain YAML data) over defaults. Drake's own errors do not say
     where (nor do its ValueErrors name a key), so on failure each leaf of raw is loaded
     alone to find the key path to name."""
+    raw = read_legacy(raw)
     try:
         text = yaml.safe_dump(raw, sort_keys=False)
         return yaml_load_typed(schema=Scenario, data=text, defaults=defaults)

@@ -17,6 +17,7 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 from drake_standup.config.controller import QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.scenario import Scenario, chair_file
+from drake_standup.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,9 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (("velocity", "path"), "human.reactive.guide"),
     (("tangent", "interaction"), "advancement.law"),
     (("hands", "time"), "standup.trigger"),
+    (SEAT_HOLDS, "phases.*.seat_hold phases.*.seat_hold_sat_back"),
+    (SEAT_PADS, "phases.*.unload[*]"),
+    (WHEN_HINDERED, "phases.*.when_hindered"),
     (QP_SOLVERS, "controller.qp_solver"),
     (tuple(GetIntegrationSchemes()), "simulator.integration_scheme"),
     (("point", "hydroelastic", "hydroelastic_with_fallback"), "plant.contact_model"),
@@ -63,7 +67,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "robot.effort_limit_Nm robot.visual_max_faces visualization.*period_s "
         "human.pulls[*].duration_s human.reactive.duration_s human.reactive.force_cap_N "
         "human.reactive.pace_mps advancement.eps advancement.psi_ddot_filter_s "
-        "standup.segment_psi standup.standing_com_height_m standup.update_period_s "
+        "phases.*.segment_psi phases.*.com_height_m standup.update_period_s "
         "controller.momentum_weight controller.*_time_constant_s "
         "controller.joint_limit_horizon_s controller.*friction_coefficient* "
         "controller.*_max_normal_force_N controller.torque_limit_Nm controller.help_* "
@@ -79,7 +83,8 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "human.reactive.damping_Ns_per_m human.reactive.travel_m "
         "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
         "human.reactive.ease_com_rise_m advancement.alpha_*_mps2 advancement.lag_tolerance_m "
-        "standup.*_s standup.*_N standup.com_ahead_of_heels_m controller.*_weight "
+        "standup.*_s standup.*_N phases.*.unload_s phases.*.exit.* phases.*.com_kp_per_s2 "
+        "controller.*_weight "
         "controller.*weight_by_joint.* controller.*_kp_* controller.*_kd_* controller.*_ki_* "
         "controller.*_damping_ratio controller.posture_limit_margin_rad controller.*_N "
         "controller.lean_max_* controller.mass_estimation_filter_s seat_hold.* "
@@ -96,15 +101,13 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "standup.guard_off_ratio standup.reseat_above_thigh_load "
         "controller.stance_vertical_weight_scale",
     ),
-    (Range(1.0, 4.0), "controller.seat_hinge_from_state controller.lean_states"),
     (2, "human.reactive.path_xz_m[*]"),
     (
         3,
         "initial.base_* visualization.*_xyz_m chair.xyz_m human.pulls[*].force_N "
-        "human.reactive.target_velocity_mps standup.segment_psi standup.state*_com_delta_m "
-        "controller.com_kp_* perturbation.pushes[*].force_N",
+        "human.reactive.target_velocity_mps phases.*.com_delta_m phases.*.com_kp_per_s2 "
+        "perturbation.pushes[*].force_N",
     ),
-    (4, "controller.base_pitch_by_state_rad"),
     (
         INTERVAL,
         "human.reactive.ease_com_rise_m controller.*_cop_*_m controller.mass_scale_bounds",

@@ -12,6 +12,7 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
 from drake_standup.config.controller import ControllerConfig
+from drake_standup.phases import PhaseTable
 from drake_standup.resources import data_root
 
 SCENARIO_DIR = data_root() / "scenarios"
@@ -198,88 +199,35 @@ class AdvancementConfig:
 
 @dataclass
 class StandupConfig:
-    """The stand-up state machine and its CoM segments (SPEC 3, 7)."""
+    """The state machine's settings across phases (SPEC 3, 7); what each state does, and
+    the guard that leaves it, is the phase table (phases.py). Reasons: docs/design.md."""
 
-    # hands: state 1 -> 2 needs the pull (both hands, x force > threshold);
-    # time: after the balancing time alone.
+    # hands: state 1 -> 2 needs the pull (both hands, x force > threshold) or the live
+    # page's button; time: the balancing time alone.
     trigger: str = "hands"
-    # Minimum time balancing seated in state 1 (SPEC 3). s.
-    balance_time_s: float = 3.0
     # x component of the force on each hand that starts the stand-up. N.
     hand_force_threshold_N: float = 10.0
-    # Both hands together pulled backwards by more than this (filtered, with the
-    # guards' hysteresis and dwell): the stand-up waits. Seated it does not start;
-    # in state 2, or in state 3 while the thighs still carry most of their load
-    # (reseat_above_thigh_load), it sits back into state 1; later in state 3 it
-    # goes back onto the thighs (state 2) while they unload, and holds once they
-    # are off. psi = t meanwhile (the pull does not help). Issue 13: 10 N backwards
-    # per hand toppled the robot over the chair; in state 2 so did 2 N per hand
-    # (4 N together, under the first threshold of 8 N), while 1 N per hand stood
-    # up (measured). N.
+    # Both hands together pulled backwards by more than this: the stand-up waits (each
+    # phase's when_hindered says how). 2 N per hand toppled the robot in state 2 under
+    # the first threshold of 8 N (docs/design.md, "A pull against the stand-up"). N.
     hindering_force_threshold_N: float = 2.5
-    # Once a hindering pull has stopped, the stand-up waits this long before it
-    # (re)starts from state 1 or goes on from state 3: the pull is over, not
-    # paused, and the arms it swung back return to their posture first. s.
+    # After a hindering pull stops, the stand-up waits this long: the pull is over, and
+    # the arms it swung back return to their posture first. s.
     resume_after_s: float = 0.5
-    # In state 3 a hindering pull sits the robot back into state 1 while the
-    # thighs' release has left them more than this fraction of their load (the
-    # plan's smoothstep); below it, the thighs still unloading, it goes back onto
-    # them in state 2 and waits there. Sat back with the thighs at 0.7 or 0.4 of
-    # their load the robot ended up further forward on the chair and its next
-    # attempt fell back; held in state 3 at 0.7-0.9, the thighs unloaded under the
-    # pull and it tipped back (measured, 15 N per hand).
+    # A step back (when_hindered) sits the robot back into state 1 while the pads its
+    # phase releases still carry more than this fraction of their load, and goes back
+    # one phase while they unload (docs/design.md, "A pull against the stand-up").
     reseat_above_thigh_load: float = 0.9
-    # Min-jerk segment lengths of states 2, 3, 4 in units of psi (= s when
-    # psi = t); the advancement version's [1.5, 0.5, 1.8] (SPEC 3).
-    segment_psi: list[float] = field(default_factory=lambda: [1.5, 0.5, 1.8])
-    # CoM displacement of state 2 (SPEC 3: [0.1277, -0.0295, 0]; the lateral
-    # part belonged to the authors' asymmetric posture, ours is symmetric). m.
-    state2_com_delta_m: list[float] = field(default_factory=lambda: [0.1277, 0.0, 0.0])
-    # CoM displacement of state 3 (SPEC 3). m.
-    state3_com_delta_m: list[float] = field(default_factory=lambda: [0.04, 0.0, 0.0])
-    # State 4's CoM path rises to this absolute height: the erect height, the
-    # CoM of the authors' state-4 posture with the soles flat on the floor
-    # (scene.erect_com_height_m: 0.5753 m on iCubGazeboV2_5, tested). Over the
-    # path's last 30 % the legs' posture takes over (controller.stance_*): near
-    # straight legs 1 cm of CoM is 0.3 rad of knee, and a CoM target alone drove
-    # the knees onto their stop (measured). 0.526 m (SPEC 7's probe) left the
-    # robot in a crouch (knees -1.09 rad). m.
-    standing_com_height_m: float = 0.575
-    # 2 -> 3: feet carry this much together (SPEC 3)... N
-    feet_force_2to3_N: float = 150.0
-    # ... after at least this long in state 2. The authors' 1.5 s (SPEC 3) equals
-    # the segment's length in psi, which "segment finished" already enforces in
-    # psi; a dwell in time would cancel the advancement, so none by default. s
-    min_time_state2_s: float = 0.0
-    # ... with the CoM this far in front of the soles' heel edge (SPEC 7:
-    # feet forces alone fired with the CoM behind the heels). m.
-    com_ahead_of_heels_m: float = 0.03
-    # 3 -> 4: each foot carries this much (SPEC 3)... N
-    foot_force_3to4_N: float = 95.0
-    # ... after at least this long in state 3 (SPEC 3: 0.5 s, the segment's
-    # length; enforced in psi as for state 2). s
-    min_time_state3_s: float = 0.0
-    # The thighs' normal-force bounds ramp to zero over this time after the
-    # switch to state 3 (SPEC 7), and state 4 waits for the ramp's end: with
-    # 1 s the bound (400 N scaled) bound only in the last 0.3 s, and state 4
-    # began with the hips still pinned by the seat (measured). s.
-    seat_release_s: float = 0.5
-    # The buttocks' normal force ramps from its load to zero over this time
-    # after the switch to state 2: the pelvis pitching forward about the hips
-    # lifts the buttocks pad (it lies behind the hip axis) off the seat. The
-    # controller had held it at >= 10 N, and for ~1 s asked >= 10 N of a pad
-    # carrying < 1 N (measured). s.
-    seat_unload_s: float = 0.2
-    # The force guards (state_machine.py) read forces low-pass filtered with
-    # this time constant: the pads' contact forces ring at 20-50 Hz. s.
+    # The force guards read forces low-pass filtered with this time constant: the pads'
+    # contact forces ring at 20-50 Hz. s.
     force_filter_time_constant_s: float = 0.05
-    # ... through Schmitt triggers: on after the filtered force stays above
-    # the threshold for guard_dwell_s, off after it stays below guard_off_ratio
-    # times the threshold as long. s, -.
+    # ... through Schmitt triggers: on after the filtered force stays above the threshold
+    # for guard_dwell_s, off after it stays below guard_off_ratio times the threshold as
+    # long. s, -.
     guard_dwell_s: float = 0.05
     guard_off_ratio: float = 0.8
-    # Period of the state machine's update; the authors' whole controller ran
-    # at 100 Hz (SPEC 3), and the guards' thresholds are met for seconds. s.
+    # Period of the state machine's update; the authors' whole controller ran at 100 Hz
+    # (SPEC 3), and the guards' thresholds are met for seconds. s.
     update_period_s: float = 0.01
 
 
@@ -404,6 +352,8 @@ class Scenario:
     human: HumanConfig = field(default_factory=HumanConfig)
     advancement: AdvancementConfig = field(default_factory=AdvancementConfig)
     standup: StandupConfig = field(default_factory=StandupConfig)
+    # What each stand-up state does and the guard that leaves it (phases.py).
+    phases: PhaseTable = field(default_factory=PhaseTable)
     # The momentum-based whole-body controller (drake_standup/controller.py).
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     # Its period: the plant's step (a whole multiple of it; a faster controller

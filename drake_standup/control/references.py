@@ -43,6 +43,7 @@ import numpy as np
 from drake_standup.config import ControllerConfig
 from drake_standup.control.spatial import yaw_pitch_rotation
 from drake_standup.control.terms import RobotTerms
+from drake_standup.phases import PhaseTable
 from drake_standup.reference import smoothstep
 
 STATES = (1, 2, 3, 4)
@@ -111,10 +112,11 @@ class StateReferences:
 
 
 class StandupSchedule:
-    """StateReferences of states 1-4 from a ControllerConfig (module docstring)."""
+    """StateReferences of states 1-4 from the phase table (phases.py)."""
 
     def __init__(
         self,
+        table: PhaseTable,
         config: ControllerConfig,
         joint_names: list[str],
         q_min: np.ndarray,
@@ -123,29 +125,20 @@ class StandupSchedule:
         margin = config.posture_limit_margin_rad
         self.q_target_min = q_min + margin
         self.q_target_max = q_max - margin
-        tables = {1: np.full(len(joint_names), np.nan)}
-        for state in STATES[1:]:
-            key = f"posture_state{state}_rad"
-            tables[state] = joint_values(joint_names, getattr(config, key), key)
-        com_gains = {
-            seated: (np.array(kp), 2.0 * config.com_damping_ratio * np.sqrt(kp))
-            for seated, kp in (
-                (True, config.com_kp_seated_per_s2),
-                (False, config.com_kp_standing_per_s2),
+        self._by_state = {}
+        for state, phase in enumerate(table, start=1):
+            target = joint_values(joint_names, phase.posture_rad, "posture_rad")
+            kp = np.array(phase.com_kp_per_s2)
+            self._by_state[state] = StateReferences(
+                kp,
+                2.0 * config.com_damping_ratio * np.sqrt(kp),
+                np.clip(target, self.q_target_min, self.q_target_max),
+                np.isnan(target),
+                phase.base_pitch_rad,
+                phase.seat_hold == "hinged",
+                phase.lean,
+                phase.stance,
             )
-        }
-        self._by_state = {
-            state: StateReferences(
-                *com_gains[state <= 2],
-                np.clip(tables[state], self.q_target_min, self.q_target_max),
-                np.isnan(tables[state]),
-                config.base_pitch_by_state_rad[state - 1],
-                state >= config.seat_hinge_from_state,
-                state in config.lean_states,
-                state == STATES[-1],
-            )
-            for state in STATES
-        }
 
     def __getitem__(self, standup_state: int) -> StateReferences:
         return self._by_state[standup_state]

@@ -1,0 +1,195 @@
+"""The phase table: what each stand-up state does, declared once (SPEC 3, 7).
+
+A scenario's `phases:` section holds one Phase per state; the defaults below are the
+table every consumer reads: the state machine (segments, guards, the answer to a
+hindering pull), the CoM reference (segments), the advancement (psi advances or not),
+the contact schedule (how the seat supports the robot) and the task references (gains,
+posture, base orientation, lean, stance).
+
+    state  phase     CoM K_P       posture        base   seat              lean  stance  psi
+    1      seated    [60, 40, 5]   as it sits     0.0    held              -     -       = t
+    2      forward   [60, 40, 5]   SPEC 3 st. 2   0.4    buttocks unload   -     -       advances
+    3      lift_off  [60, 40, 30]  SPEC 3 st. 3   0.3    thighs unload     yes   -       advances
+    4      rise      [60, 40, 30]  SPEC 3 st. 4   0.0    off the chair     yes   yes     advances
+
+    leaves when (Guard, all of them, and no hindering pull for standup.resume_after_s):
+    1 -> 2   3 s balanced, the stand-up asked for (standup.trigger)
+    2 -> 3   segment done, the feet carry > 150 N together, the CoM 3 cm ahead of the heels
+    3 -> 4   the thighs unloaded, segment done, each foot carries > 95 N
+    a pull against the stand-up: 1 waits, 2 sits back, 3 steps back, 4 stands (leans)
+
+Why these values: docs/design.md, "The phase table". Older scenario files spelled parts
+of this table as separate keys of standup: and controller: (config/legacy.py reads them).
+"""
+
+from dataclasses import dataclass, field
+
+# The phases in the order of the stand-up states 1-4.
+PHASES = ("seated", "forward", "lift_off", "rise")
+# Pad groups of the chair whose load a phase can release (models/icub_contact.yaml).
+SEAT_PADS = ("buttocks", "thighs")
+SEAT_HOLDS = ("held", "hinged")
+# What a phase does under a pull against the stand-up (state_machine.py).
+WHEN_HINDERED = ("wait", "sit_back", "step_back", "stand")
+
+_LEGS = ("hip_pitch", "hip_roll", "knee", "ankle_pitch")
+_ARMS = ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
+
+
+def posture(values: list[float]) -> dict[str, float]:
+    """A SPEC 3 posture row [hip pitch, roll, knee, ankle pitch | shoulder pitch, roll, yaw,
+    elbow | torso pitch], both sides alike, as joint name -> rad."""
+    table = {
+        f"{side}_{joint}": value
+        for side in "lr"
+        for joint, value in zip(_LEGS + _ARMS, values[:8], strict=True)
+    }
+    table["torso_pitch"] = values[8]
+    return table
+
+
+@dataclass
+class Guard:
+    """What leaves a phase: every condition set here holds, and no pull against the
+    stand-up has been felt for standup.resume_after_s (state_machine.py)."""
+
+    # At least this long in the phase. s.
+    min_time_s: float = 0.0
+    # The stand-up was asked for: standup.trigger (the hands' pull, or time), or the live
+    # page's Stand up button.
+    asked: bool = False
+    # The phase's CoM segment is done: psi past its end (a segment that does not move is
+    # done at once). It keeps the reference's slope continuous across the switch.
+    segment_done: bool = True
+    # The pads this phase unloads have finished unloading (unload_s after entry).
+    unloaded: bool = False
+    # Both soles together carry more than this (filtered, Schmitt trigger). N.
+    feet_force_N: float | None = None
+    # Each sole carries more than this. N.
+    each_foot_force_N: float | None = None
+    # The CoM at least this far in front of the soles' heel edge (SPEC 7: the feet's
+    # forces alone fired with the CoM behind the heels). m.
+    com_ahead_of_heels_m: float | None = None
+
+
+@dataclass
+class Phase:
+    """One stand-up state's behaviour."""
+
+    # The CoM segment the phase follows from its entry (reference.py: min jerk): its
+    # length in psi (= s at psi = t), its displacement, optionally an absolute end height
+    # (replacing the displacement's z) and a start at the CoM's measured height instead of
+    # the previous segment's end. In `seated` the length is that of the return to the
+    # seat after a sit-back (the phase itself holds the CoM where it sits).
+    segment_psi: float = 1.0
+    com_delta_m: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    com_height_m: float | None = None
+    start_at_com_height: bool = False
+    # CoM stiffness K_P (x, y, z); K_D = 2 zeta sqrt(K_P) (controller.com_damping_ratio).
+    # 1/s^2.
+    com_kp_per_s2: list[float] = field(default_factory=lambda: [60.0, 40.0, 5.0])
+    # Posture target by joint name; a joint not named holds the posture of the first
+    # tick. rad.
+    posture_rad: dict[str, float] = field(default_factory=dict)
+    # Forward pitch of the base's (root_link's) target orientation. rad.
+    base_pitch_rad: float = 0.0
+    # How the seat contact holds the pelvis while the buttocks are seated: held (all six
+    # rows) or hinged (free to pitch about the hip axis); and after a sit-back.
+    seat_hold: str = "held"
+    seat_hold_sat_back: str = "hinged"
+    # Pad groups (SEAT_PADS) whose load is released from this phase's entry, over
+    # unload_s (smoothstep); released pads stay so in the later phases. s.
+    unload: list[str] = field(default_factory=list)
+    unload_s: float = 0.0
+    # The CoM target leans against the hands' pull (the feet alone carry the robot).
+    lean: bool = False
+    # The legs' posture, not the CoM height, ends the segment (controller.stance_*).
+    stance: bool = False
+    # psi may run ahead of time here (advancement.py).
+    advances: bool = True
+    # The answer to a pull against the stand-up (WHEN_HINDERED).
+    when_hindered: str = "wait"
+    exit: Guard = field(default_factory=Guard)
+
+
+@dataclass
+class PhaseTable:
+    """The four phases, in the order of the stand-up states (PHASES). The last is final:
+    its exit is never taken."""
+
+    # 1: balance on the chair (SPEC 3), the initial posture held.
+    seated: Phase = field(
+        default_factory=lambda: Phase(
+            segment_psi=1.5,
+            advances=False,
+            exit=Guard(min_time_s=3.0, asked=True),
+        )
+    )
+    # 2: the CoM forward over the feet (SPEC 3: [0.1277, -0.0295, 0]; the lateral part
+    # belonged to the authors' asymmetric posture, ours is symmetric), the pelvis pitched
+    # forward; the buttocks lift off the seat.
+    forward: Phase = field(
+        default_factory=lambda: Phase(
+            segment_psi=1.5,
+            com_delta_m=[0.1277, 0.0, 0.0],
+            posture_rad=posture(
+                [1.5402, 0.1594, -1.7365, -0.2814, -1.6455, 0.4363, 0.5862, 0.2473, 1.0]
+            ),
+            base_pitch_rad=0.4,
+            seat_hold="hinged",
+            unload=["buttocks"],
+            unload_s=0.2,
+            when_hindered="sit_back",
+            exit=Guard(feet_force_N=150.0, com_ahead_of_heels_m=0.03),
+        )
+    )
+    # 3: the CoM further forward (SPEC 3), its height stiffened from where it is; the
+    # thighs lift off the seat.
+    lift_off: Phase = field(
+        default_factory=lambda: Phase(
+            segment_psi=0.5,
+            com_delta_m=[0.04, 0.0, 0.0],
+            start_at_com_height=True,
+            com_kp_per_s2=[60.0, 40.0, 30.0],
+            posture_rad=posture(
+                [1.1097, 0.0122, -0.8365, -0.0714, -1.4615, 0.4363, 0.1545, 0.2018, 0.0611]
+            ),
+            base_pitch_rad=0.3,
+            seat_hold="hinged",
+            unload=["thighs"],
+            unload_s=0.5,
+            lean=True,
+            when_hindered="step_back",
+            exit=Guard(unloaded=True, each_foot_force_N=95.0),
+        )
+    )
+    # 4: up to the erect CoM height (scene.erect_com_height_m of this posture: 0.5753 m
+    # on iCubGazeboV2_5), the legs' posture ending the rise; the final state.
+    rise: Phase = field(
+        default_factory=lambda: Phase(
+            segment_psi=1.8,
+            com_height_m=0.575,
+            com_kp_per_s2=[60.0, 40.0, 30.0],
+            posture_rad=posture(
+                [0.2094, 0.1047, -0.1745, -0.0349, -1.6455, 0.4363, 0.5862, 0.2473, 0.0]
+            ),
+            seat_hold="hinged",
+            lean=True,
+            stance=True,
+            when_hindered="stand",
+        )
+    )
+
+    def phase(self, state: int) -> Phase:
+        """The phase of stand-up state 1-4."""
+        return getattr(self, PHASES[state - 1])
+
+    def __iter__(self):
+        return (getattr(self, name) for name in PHASES)
+
+    def unloading_phase(self, pads: str) -> int | None:
+        """The state (1-4) whose entry starts the release of a pad group, None if none."""
+        for state, phase in enumerate(self, start=1):
+            if pads in phase.unload:
+                return state
+        return None
