@@ -44,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drake_standup.cli import OneLineErrorParser
+from drake_standup.arguments import OneLineErrorParser
 from drake_standup.config import SCENARIO_DIR
 from drake_standup.outputs import group_normal_forces
 
