@@ -52,6 +52,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.arguments import OneLineErrorParser, positive_float, positive_int
 from drake_standup.config import DEFAULT_SCENARIO, Scenario, ScenarioError, load_scenario
+from drake_standup.config.inputs import check_output_dir
 from drake_standup.controller import WholeBodyController
 from drake_standup.diagram import add_seat_hold, build_diagram
 from drake_standup.scene import add_scene, set_seated_state
@@ -394,6 +395,12 @@ def main(argv: list[str] | None = None, prog: str = "python -m drake_standup.ben
     t_bench = time.perf_counter()
     git_start, load_start = _git(), list(os.getloadavg())
     try:
+        # --out and --profile are files: their folders are checked before any simulation.
+        for flag, path in (("--out", args.out), ("--profile", args.profile)):
+            if path is not None:
+                if path.is_dir():
+                    raise ScenarioError(f"{flag}: '{path}' is a folder; accepted: a file path")
+                check_output_dir(path.parent, flag)
         scenario = load_scenario(args.scenario)
     except ScenarioError as err:
         print(f"error: {err}", file=sys.stderr)

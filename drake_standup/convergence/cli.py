@@ -37,7 +37,8 @@ import sys
 from pathlib import Path
 
 from drake_standup.arguments import OneLineErrorParser
-from drake_standup.config import SCENARIO_DIR
+from drake_standup.config import SCENARIO_DIR, ScenarioError
+from drake_standup.config.inputs import check_output_dir
 from drake_standup.convergence.cases import SCENARIOS, STEPS_MS
 from drake_standup.convergence.report import fmt
 from drake_standup.convergence.study import run_study
@@ -93,6 +94,13 @@ def main(argv: list[str] | None = None, prog: str = "python -m drake_standup.con
             f"error: --scenarios: '{unknown[0]}' unknown; accepted: {', '.join(shipped)}",
             file=sys.stderr,
         )
+        return 2
+    try:  # a folder that cannot be written fails now, not after the runs
+        check_output_dir(args.out, "--out")
+        if args.docs is not None:
+            check_output_dir(args.docs, "--docs")
+    except ScenarioError as err:
+        print(f"error: {err}", file=sys.stderr)
         return 2
     scenarios = list(dict.fromkeys(args.scenarios))
     steps = sorted(set(args.steps_ms))
