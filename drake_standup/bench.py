@@ -34,7 +34,6 @@ import cProfile
 import hashlib
 import importlib.metadata
 import json
-import math
 import os
 import platform
 import pstats
@@ -51,8 +50,9 @@ import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from drake_standup.cli import OneLineErrorParser
+from drake_standup.arguments import OneLineErrorParser, positive_float, positive_int
 from drake_standup.config import DEFAULT_SCENARIO, Scenario, ScenarioError, load_scenario
+from drake_standup.config.inputs import check_output_dir
 from drake_standup.controller import WholeBodyController
 from drake_standup.diagram import add_seat_hold, build_diagram
 from drake_standup.scene import add_scene, set_seated_state
@@ -344,20 +344,6 @@ def _git() -> dict:
     }
 
 
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
-    return value
-
-
-def _positive_float(text: str) -> float:
-    value = float(text)
-    if not (math.isfinite(value) and value > 0.0):
-        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, got {text}")
-    return value
-
-
 def _parser(prog: str) -> argparse.ArgumentParser:
     parser = OneLineErrorParser(
         prog=prog,
@@ -372,20 +358,20 @@ def _parser(prog: str) -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--duration",
-        type=_positive_float,
+        type=positive_float,
         default=None,
         help="simulated s per closed-loop run (b, c); default: the scenario's duration_s",
     )
     parser.add_argument(
         "--plant-duration",
-        type=_positive_float,
+        type=positive_float,
         default=3.0,
         help="simulated s per plant-only seated hold (a); default 3",
     )
-    parser.add_argument("--repeat", type=_positive_int, default=3, help="runs of each; default 3")
+    parser.add_argument("--repeat", type=positive_int, default=3, help="runs of each; default 3")
     parser.add_argument(
         "--plant-steps",
-        type=_positive_int,
+        type=positive_int,
         default=300,
         help="single steps timed for the plant step; default 300",
     )
@@ -409,6 +395,12 @@ def main(argv: list[str] | None = None, prog: str = "python -m drake_standup.ben
     t_bench = time.perf_counter()
     git_start, load_start = _git(), list(os.getloadavg())
     try:
+        # --out and --profile are files: their folders are checked before any simulation.
+        for flag, path in (("--out", args.out), ("--profile", args.profile)):
+            if path is not None:
+                if path.is_dir():
+                    raise ScenarioError(f"{flag}: '{path}' is a folder; accepted: a file path")
+                check_output_dir(path.parent, flag)
         scenario = load_scenario(args.scenario)
     except ScenarioError as err:
         print(f"error: {err}", file=sys.stderr)

@@ -13,6 +13,8 @@ import importlib
 import sys
 from pathlib import Path
 
+from drake_standup.arguments import OneLineErrorParser, parse_set
+
 # Command -> (module with main(argv, prog), one line of help).
 COMMANDS = {
     "run": ("drake_standup.cli", "simulate one scenario: recording, metrics, figures"),
@@ -22,14 +24,6 @@ COMMANDS = {
     "convergence": ("drake_standup.convergence", "the plant-step convergence study"),
     "scenarios": ("drake_standup.cli", "list the shipped scenarios and sweeps"),
 }
-
-
-class OneLineErrorParser(argparse.ArgumentParser):
-    """argparse, but a bad argument is one 'error:' line and exit code 2."""
-
-    def error(self, message: str) -> None:
-        print(f"error: {message}; see --help", file=sys.stderr)
-        sys.exit(2)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -108,23 +102,6 @@ def run_parser(prog: str) -> OneLineErrorParser:
         "(drake_standup/live.py); without --duration until Stop or Ctrl-C (at most 300 s)",
     )
     return parser
-
-
-def parse_set(text: str) -> tuple[str, object]:
-    """--set's 'key.path=value' (the value in YAML: 2.0, time, [1, 0, 2]) -> (path, value)."""
-    import yaml
-
-    from drake_standup.config import ScenarioError
-
-    path, equals, value = text.partition("=")
-    try:
-        if equals and path.strip():
-            return path.strip(), yaml.safe_load(value)
-    except yaml.YAMLError:
-        pass
-    raise ScenarioError(
-        f"--set {text}: accepted: key.path=VALUE (YAML), e.g. advancement.eps=1.0e-4"
-    )
 
 
 def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> int:

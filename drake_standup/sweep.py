@@ -21,7 +21,7 @@ import traceback
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from drake_standup.cli import OneLineErrorParser
+from drake_standup.arguments import OneLineErrorParser
 from drake_standup.cluster import run_on_cluster
 from drake_standup.config import ScenarioError, parse_scenario
 from drake_standup.outputs import write_json

@@ -22,7 +22,7 @@ import sys
 import time
 from pathlib import Path
 
-from drake_standup.cli import OneLineErrorParser
+from drake_standup.arguments import OneLineErrorParser
 from drake_standup.sweep import run_sweep
 from drake_standup.sweep_file import load_sweep
 from drake_standup.sweep_table import simulation_rows

@@ -191,3 +191,22 @@ def test_profile_writes_a_loadable_profile(tmp_path, capsys):
     text = path.with_suffix(".txt").read_text()
     assert "by cumulative" in text and "by tottime" in text
     assert _positive(summary["profile"]["sim_s_per_wall_s_under_profiler"])
+
+
+@pytest.mark.parametrize(
+    ("flag", "where"),
+    [("--out", "under a file"), ("--profile", "under a file"), ("--out", "a folder")],
+)
+def test_an_output_file_that_cannot_be_written_is_one_error_line_before_any_run(
+    flag, where, tmp_path, capsys, monkeypatch
+):
+    in_the_way = tmp_path / "file"
+    in_the_way.write_text("")
+    path = in_the_way / "bench.json" if where == "under a file" else tmp_path
+    monkeypatch.setattr(bench, "_model_build", lambda _: pytest.fail("ran before the check"))
+    assert bench.main([*TINY, flag, str(path)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    (line,) = captured.err.splitlines()  # one line: no traceback
+    expected = f"'{in_the_way}' is a file" if where == "under a file" else f"'{path}' is a folder"
+    assert line.startswith(f"error: {flag}: {expected}; accepted: ")

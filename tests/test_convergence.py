@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 
+import drake_standup.convergence.cli as convergence_cli
 from drake_standup.convergence import (
     BOUNDS,
     COM_DEVIATION_M,
@@ -306,6 +307,21 @@ def test_bad_options_are_one_error_line_and_exit_2(argv, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: --")
     assert not (tmp_path / "runs").exists()
+
+
+@pytest.mark.parametrize("flag", ["--out", "--docs"])
+def test_an_output_folder_that_is_a_file_is_one_error_line_before_any_run(
+    flag, tmp_path, capsys, monkeypatch
+):
+    in_the_way = tmp_path / "file"
+    in_the_way.write_text("")
+    monkeypatch.setattr(
+        convergence_cli, "run_study", lambda *_, **__: pytest.fail("ran before the check")
+    )
+    argv = ["--out", str(tmp_path / "out"), "--scenarios", "seated", "--steps-ms", "1"]
+    assert main([*argv, flag, str(in_the_way)]) == 2
+    (line,) = capsys.readouterr().err.splitlines()  # one line: no traceback
+    assert line.startswith(f"error: {flag}: '{in_the_way}' is a file; accepted: a folder")
 
 
 def test_a_run_that_cannot_start_replaces_the_old_runs_files(tmp_path):
