@@ -136,11 +136,10 @@ class TrajectoryAdvancement(LeafSystem):
         self._tangent = self.DeclareVectorInputPort("path_tangent_W", 3)
         # Unconnected (unit tests): no taper.
         self._progress = self.DeclareVectorInputPort("path_progress", 1)
-        # The stand-up state (state machine): psi advances only along the stand-up's
-        # own segments, states 2-4. State 1 balances seated, or returns to the seat
-        # after a hindering pull: a backward pull helped that return, and psi ran
-        # at 2.4 (measured). Unconnected (unit tests): every state advances.
-        self._standup_state = self.DeclareVectorInputPort("standup_state", 1)
+        # Whether the stand-up's phase lets psi advance (> 0.5; phases.py: advances):
+        # not while balancing seated or returning to the seat after a hindering pull,
+        # which a backward pull helps (docs/design.md). Unconnected: it always may.
+        self._advances = self.DeclareVectorInputPort("advances", 1)
         self.DeclareVectorOutputPort(
             "psi",
             1,
@@ -158,7 +157,7 @@ class TrajectoryAdvancement(LeafSystem):
                 self._x_d,
                 self._tangent,
                 self._progress,
-                self._standup_state,
+                self._advances,
             )
         }
         self._law_cache = declare_cached(self, "psi_dot law", self._calc_law, inputs)
@@ -178,8 +177,8 @@ class TrajectoryAdvancement(LeafSystem):
 
     def _calc_law(self, context: Context) -> tuple[float, float]:
         tangent = self._tangent.Eval(context)
-        if self._standup_state.HasValue(context) and self._standup_state.Eval(context)[0] < 1.5:
-            tangent = np.zeros(3)  # state 1: nothing to advance along
+        if self._advances.HasValue(context) and self._advances.Eval(context)[0] < 0.5:
+            tangent = np.zeros(3)  # a phase that holds psi = t: nothing to advance along
         return psi_dot_law(
             self._config,
             self._v.Eval(context),

@@ -53,7 +53,7 @@ from pydrake.systems.framework import DiagramBuilder
 from drake_standup.arguments import OneLineErrorParser, positive_float, positive_int
 from drake_standup.config import DEFAULT_SCENARIO, Scenario, ScenarioError, load_scenario
 from drake_standup.config.inputs import check_output_dir
-from drake_standup.controller import WholeBodyController
+from drake_standup.control.controller import TIMING
 from drake_standup.diagram import add_seat_hold, build_diagram
 from drake_standup.scene import add_scene, set_seated_state
 from drake_standup.simulate import RunResult, simulate
@@ -132,7 +132,7 @@ def _tick_split(results: list[RunResult]) -> dict:
     """Median, p95 and mean per column of WholeBodyController.timing_s(), in us,
     over every tick of every run."""
     timing = np.concatenate([r.controller_timing_s for r in results])
-    columns = [name.removesuffix("_s") + "_us" for name in WholeBodyController.TIMING]
+    columns = [name.removesuffix("_s") + "_us" for name in TIMING]
     us = 1e6 * timing
     split = {name: _us_stats(us[:, k]) for k, name in enumerate(columns)}
     # The parts are disjoint intervals inside the tick: what they leave of the
@@ -180,7 +180,14 @@ def _plant_step(scenario: Scenario, steps: int) -> dict:
     builder = DiagramBuilder()
     hold = scenario.seat_hold
     scene = add_scene(builder, scenario, pd_gains=(hold.kp_Nm_per_rad, hold.kd_Nms_per_rad))
-    add_seat_hold(builder, scene, scenario)
+    instance = scene.robot.model_instance
+    add_seat_hold(
+        builder,
+        scene,
+        scenario,
+        scene.plant.get_desired_state_input_port(instance),
+        scene.plant.get_actuation_input_port(instance),
+    )
     simulator = Simulator(builder.Build())
     ApplySimulatorConfig(scenario.simulator, simulator)
     set_seated_state(
@@ -191,9 +198,10 @@ def _plant_step(scenario: Scenario, steps: int) -> dict:
     built = build_diagram(scenario, None, "seat_hold")
     simulator = Simulator(built.diagram)
     ApplySimulatorConfig(scenario.simulator, simulator)
+    station = built.station
     set_seated_state(
-        built.scene,
-        built.scene.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()),
+        station.scene,
+        station.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()),
         scenario,
     )
     diagram = _step_times_s(simulator, step_s, steps)

@@ -43,8 +43,9 @@ from pydrake.systems.framework import (
 
 from drake_standup.config import HumanConfig, Scenario
 from drake_standup.human import hand_forces, spatial_forces
+from drake_standup.outputs import write_run
 from drake_standup.robot import Robot
-from drake_standup.simulate import RunResult, simulate
+from drake_standup.runner import Run, RunResult, advance, collect, finished, on_plant_grid, prepare
 
 # The page's controls, in the order they appear.
 HANDS = ("left", "right")
@@ -208,9 +209,9 @@ def make_live_meshcat() -> Meshcat:
 
 
 class LiveSession:
-    """What simulate() calls in a live run: the human to build, then after
-    Initialize (started) and after every chunk of simulated time (after_chunk,
-    True: stop). Owns the page's Reset and Stop buttons and the pacing report."""
+    """A live run's page: the human to build (make_human, for runner.prepare), then after
+    Initialize (started) and after every chunk of simulated time (after_chunk, True:
+    stop). Owns the page's Reset and Stop buttons and the pacing report."""
 
     def __init__(self, scenario: Scenario, meshcat: Meshcat, report=print):
         self.meshcat = meshcat
@@ -242,14 +243,14 @@ class LiveSession:
         self.meshcat.AddButton(STOP, "Escape")
         return self.human
 
-    def started(self, simulator: Simulator, built, fall=None) -> None:
+    def started(self, run: Run) -> None:
         """After Initialize: the seated state that Reset returns to; and the run's fall
         monitor, which in a live run reports a fall (or the QP failing) once instead of
         ending the run: Reset puts the robot back."""
+        simulator = run.simulator
         self._initial_state = simulator.get_context().Clone()
-        self._fall = fall
-        if fall is not None:
-            simulator.set_monitor(self._monitor)
+        self._fall = run.fall
+        simulator.set_monitor(self._monitor)
         self._restart_clocks(simulator)
 
     def _monitor(self, root_context: Context) -> EventStatus:
@@ -267,14 +268,15 @@ class LiveSession:
         self._wall = self._pace_wall = time.perf_counter()
         self._sim = self._pace_sim = simulator.get_context().get_time()
 
-    def reset(self, simulator: Simulator, built) -> None:
+    def reset(self, run: Run) -> None:
         """The robot back on the chair as at t = 0, time running on: every state
         (plant, controller, psi, state machine, the helper's) from the start, then
         the initialization events at the current time (the state machine's clock and
         the controller's first torques)."""
+        simulator = run.simulator
         context = simulator.get_mutable_context()
         context.SetStateAndParametersFrom(self._initial_state)
-        built.diagram.ExecuteInitializationEvents(context)
+        run.built.diagram.ExecuteInitializationEvents(context)
         if self.human is not None:
             self.human.forget_clicks()
         if self._fall is not None:
@@ -283,7 +285,8 @@ class LiveSession:
         simulator.ResetStatistics()
         self.resets += 1
 
-    def after_chunk(self, simulator: Simulator, built) -> bool:
+    def after_chunk(self, run: Run) -> bool:
+        simulator = run.simulator
         m = self.meshcat
         if self.interrupted:
             self.stopped_by = "Ctrl-C"
@@ -294,7 +297,7 @@ class LiveSession:
         clicks = m.GetButtonClicks(RESET)
         if clicks > self._reset_clicks:
             self._reset_clicks = clicks
-            self.reset(simulator, built)
+            self.reset(run)
             self._restart_clocks(simulator)
             return False
         self._pace(simulator)
@@ -320,9 +323,15 @@ class LiveSession:
 
 
 def run_live(
-    scenario: Scenario, out_dir: Path, duration_s: float | None = None, realtime_rate: float = 1.0
+    scenario: Scenario,
+    out_dir: Path,
+    duration_s: float | None = None,
+    realtime_rate: float = 1.0,
+    chunk_s: float = 0.05,
 ) -> RunResult:
-    """The live run; prints the page's address, returns simulate()'s RunResult."""
+    """The live run (runner.py's prepare, advance and collect, with the page between the
+    chunks); prints the page's address, writes the run's files (no psi = t run: nobody
+    knows the pull in advance) and returns its RunResult."""
     scenario = copy.deepcopy(scenario)
     scenario.duration_s = DEFAULT_DURATION_S if duration_s is None else duration_s
     scenario.simulator.target_realtime_rate = realtime_rate
@@ -335,7 +344,19 @@ def run_live(
 
     previous = signal.signal(signal.SIGINT, interrupt)
     try:
-        result = simulate(scenario, out_dir, progress=False, live=session)
+        run = prepare(scenario, meshcat, make_human=session.make_human, live_transforms=True)
+        session.started(run)
+        chunk_s = on_plant_grid(chunk_s, scenario)
+        chunk = 0
+        while not finished(run):
+            chunk += 1
+            advance(run, chunk * chunk_s)
+            if session.after_chunk(run):
+                break
+        if run.failure_reason is None:
+            run.failure_reason = session.fell  # a fall that no Reset undid
+        result = collect(run)
+        result.files = write_run(run, result, out_dir)
     finally:
         signal.signal(signal.SIGINT, previous)
     if session.stopped_by is not None:

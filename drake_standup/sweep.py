@@ -24,7 +24,7 @@ from pathlib import Path
 from drake_standup.arguments import OneLineErrorParser
 from drake_standup.cluster import run_on_cluster
 from drake_standup.config import ScenarioError, parse_scenario
-from drake_standup.outputs import write_json
+from drake_standup.records import write_json
 from drake_standup.sweep_figures import draw_figure
 from drake_standup.sweep_file import RunSpec, SweepError, SweepSpec, expand, load_sweep
 from drake_standup.sweep_table import write_table
@@ -37,7 +37,7 @@ def run_one(base_text: str, overrides: list) -> dict:
 
     Runs in a Dask worker: its own diagram, simulator and plant contexts.
     """
-    from drake_standup.outputs import json_safe
+    from drake_standup.records import json_safe
     from drake_standup.simulate import simulate
 
     t0 = time.perf_counter()

@@ -13,6 +13,7 @@ from pydrake.systems.analysis import Simulator
 
 from drake_standup.advancement import TrajectoryAdvancement, lead, psi_dot_law
 from drake_standup.config import AdvancementConfig
+from drake_standup.phases import PhaseTable
 from drake_standup.robot import ContactModel, add_icub
 from drake_standup.sensing import RobotSensing
 
@@ -91,11 +92,11 @@ def test_interaction_law_value_matches_the_authors_ratio():
     )
 
 
-def _simulate_advancement(cfg, v, omega_f, tangent, t_end, standup_state=None):
+def _simulate_advancement(cfg, v, omega_f, tangent, t_end, advances=None):
     system = TrajectoryAdvancement(cfg)
     context = system.CreateDefaultContext()
-    if standup_state is not None:
-        system.GetInputPort("standup_state").FixValue(context, [standup_state])
+    if advances is not None:
+        system.GetInputPort("advances").FixValue(context, [float(advances)])
     # CoM on its reference: the lead gate is open.
     system.GetInputPort("com_W").FixValue(context, np.zeros(3))
     system.GetInputPort("x_d_W").FixValue(context, np.zeros(3))
@@ -136,17 +137,20 @@ def test_psi_integrates_the_rate_that_follows_the_law():
         assert system.GetOutputPort("psi_dot_law").Eval(context)[0] == pytest.approx(r)
 
 
-@pytest.mark.parametrize("standup_state", [1, 2, 3, 4])
-def test_psi_advances_only_in_the_stand_ups_own_states(standup_state):
-    """The same helpful inputs: psi = t in state 1 (seated, or returning to the seat
-    after a hindering pull), the law's rate r in states 2-4."""
+@pytest.mark.parametrize("state", [1, 2, 3, 4])
+def test_psi_advances_only_where_the_phase_table_lets_it(state):
+    """The same helpful inputs, the phase of each state's advances flag (phases.py):
+    psi = t in state 1 (seated, or returning to the seat after a hindering pull), the
+    law's rate r in states 2-4."""
     v = 1.6 * TANGENT
     omega_f = TANGENT / np.linalg.norm(TANGENT)
     r = (v @ TANGENT) / (TANGENT @ TANGENT + CFG.eps)
-    system, context = _simulate_advancement(CFG, v, omega_f, TANGENT, 1.0, standup_state)
-    expected = 1.0 if standup_state == 1 else r
+    advances = PhaseTable().phase(state).advances
+    assert advances == (state > 1)
+    system, context = _simulate_advancement(CFG, v, omega_f, TANGENT, 1.0, advances)
+    expected = r if advances else 1.0
     assert system.GetOutputPort("psi_dot_law").Eval(context)[0] == pytest.approx(expected)
-    if standup_state == 1:
+    if not advances:
         assert system.GetOutputPort("psi").Eval(context)[0] == pytest.approx(1.0, abs=1e-9)
 
 

@@ -354,7 +354,7 @@ class Scenario:
     standup: StandupConfig = field(default_factory=StandupConfig)
     # What each stand-up state does and the guard that leaves it (phases.py).
     phases: PhaseTable = field(default_factory=PhaseTable)
-    # The momentum-based whole-body controller (drake_standup/controller.py).
+    # The momentum-based whole-body controller (drake_standup/control/controller.py).
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     # Its period: the plant's step (a whole multiple of it; a faster controller
     # is wasted on a discrete plant). 250 Hz; the authors ran 100 Hz (SPEC 3).

@@ -39,10 +39,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from pydrake.common.value import Value
+from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
+from drake_standup.caching import declare_cached
 from drake_standup.config import ControllerConfig
 from drake_standup.control.spatial import yaw_pitch_rotation
 from drake_standup.control.terms import RobotTerms
+from drake_standup.payloads import COM_REFERENCE, HAND_WRENCHES
 from drake_standup.phases import PhaseTable
 from drake_standup.reference import smoothstep
 
@@ -365,3 +369,74 @@ class ReferenceGenerator:
             next_height_integral=next_height_integral,
             next_posture=np.concatenate((self._latched, q_initial, q_next, (base_yaw,))),
         )
+
+
+class TaskReferenceGenerator(LeafSystem):
+    """Each tick's TaskReferences (ReferenceGenerator.calc) as a system, every period_s.
+
+    Inputs: terms (abstract RobotTerms, control/model.py), standup_state (1),
+    com_reference (9, payloads.COM_REFERENCE), hand_wrenches_W (12), path_progress (1;
+    unconnected: 1, the segment finished). Outputs: task_references (abstract
+    TaskReferences) and lean_W (3: the CoM target's lean after the last tick, m).
+    Discrete state: the angular momentum's integral (3, N m s^2), the posture state
+    (TaskReferences.next_posture), the lean (3, m), the stance's height integral (1, m s).
+    """
+
+    def __init__(self, generator: ReferenceGenerator, period_s: float):
+        super().__init__()
+        self._generator = generator
+        self._period_s = period_s
+        nu = len(generator.schedule.q_target_min)
+        self._terms = self.DeclareAbstractInputPort("terms", Value[object](None))
+        self._state_input = self.DeclareVectorInputPort("standup_state", 1)
+        self._reference = self.DeclareVectorInputPort("com_reference", COM_REFERENCE.size)
+        self._hands = self.DeclareVectorInputPort("hand_wrenches_W", HAND_WRENCHES.size)
+        self._progress = self.DeclareVectorInputPort("path_progress", 1)
+        self._integral = self.DeclareDiscreteState(3)
+        # [latched flag, state-1 posture (nu), filtered posture reference (nu), base yaw].
+        self._posture = self.DeclareDiscreteState(2 + 2 * nu)
+        self._lean = self.DeclareDiscreteState(3)
+        self._height_integral = self.DeclareDiscreteState(1)
+        self._references = declare_cached(
+            self, "task references", self._calc, {self.all_sources_ticket()}
+        )
+        self.DeclareAbstractOutputPort(
+            "task_references",
+            lambda: Value[object](None),
+            self._CalcReferences,
+            {self._references.ticket()},
+        )
+        self.DeclareStateOutputPort("lean_W", self._lean)
+        self.DeclareInitializationDiscreteUpdateEvent(self._Update)
+        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
+
+    def _calc(self, context: Context) -> TaskReferences:
+        state = context.get_discrete_state()
+        F_hand_W = self._hands.Eval(context)
+        progress = (
+            float(self._progress.Eval(context)[0]) if self._progress.HasValue(context) else 1.0
+        )
+        standup_state = min(max(int(round(self._state_input.Eval(context)[0])), 1), 4)
+        return self._generator.calc(
+            self._terms.Eval(context),
+            standup_state,
+            self._reference.Eval(context),
+            F_hand_W if F_hand_W.any() else None,
+            state.get_value(self._integral),
+            state.get_value(self._posture),
+            state.get_value(self._lean),
+            progress,
+            float(state.get_value(self._height_integral)[0]),
+        )
+
+    def _CalcReferences(self, context: Context, output: Value) -> None:
+        output.set_value(self._references.Eval(context))
+
+    def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
+        references = self._references.Eval(context)
+        terms = self._terms.Eval(context)
+        integral = context.get_discrete_state(self._integral).value()
+        discrete_state.set_value(self._integral, integral + self._period_s * terms.L_WCom[:3])
+        discrete_state.set_value(self._posture, references.next_posture)
+        discrete_state.set_value(self._lean, references.lean_W)
+        discrete_state.set_value(self._height_integral, [references.next_height_integral])

@@ -41,22 +41,25 @@ class MomentumTask(Task):
         self,
         layout: QpLayout,
         contact_map: ContactMap,
-        W_gravity: np.ndarray,
+        gravity_W: np.ndarray,
         weight: float,
     ):
+        """gravity_W: g (3,), m/s^2; the weight m g is the model's, terms.mass_kg."""
         self._weight = weight
         self.weight = np.full(6, weight)
         self.columns = layout.wrenches
         self.A = np.empty((6, layout.n_wrench))
         self.b = np.empty(6)
         self._contact_map = contact_map
-        self._W_gravity = W_gravity  # [0; m g], N
+        self._gravity_W = gravity_W
+        self._W_gravity = np.zeros(6)  # [0; m g], N
 
     def update(self, terms: RobotTerms, references: TaskReferences) -> None:
         A, b = self.A, self.b
         self.weight[5] = self._weight * references.vertical_weight_scale
         A[:] = self._contact_map(terms)[:, :6].T
         A[:3] -= skew(terms.p_BoCom) @ A[3:]
+        self._W_gravity[3:] = terms.mass_kg * self._gravity_W
         np.subtract(references.Ldot_star, self._W_gravity, out=b)
         if references.tau_hand is not None:
             W_hand_Bo = references.tau_hand[:6]

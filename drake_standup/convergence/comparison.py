@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from drake_standup.convergence.runs import RunData
-from drake_standup.outputs import group_normal_forces
+from drake_standup.signals import group_normal_forces
 
 # --- Issue 11's bounds --------------------------------------------------------
 # A run passes when, against the same scenario's 1 ms run, every one of these

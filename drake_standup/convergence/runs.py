@@ -38,7 +38,7 @@ def run_case(
     never taken for a finished one, nor its folder read as an older run's.
     """
     from drake_standup.config import parse_scenario, validate
-    from drake_standup.outputs import json_safe
+    from drake_standup.records import json_safe
     from drake_standup.simulate import simulate
 
     run_dir = Path(out_dir)
@@ -75,7 +75,7 @@ class RunData:
 
 def load_run(run_dir: Path) -> RunData:
     """The run in run_dir as its files hold it ({} and None for what is missing)."""
-    from drake_standup.outputs import load_signals
+    from drake_standup.signals import load_signals
 
     metrics_path = Path(run_dir) / "metrics.json"
     metrics = json.loads(metrics_path.read_text()) if metrics_path.is_file() else {}

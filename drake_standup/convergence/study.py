@@ -51,7 +51,7 @@ def run_study(
 ) -> StudyResult:
     """Simulates what OUT/runs/ does not hold yet, compares, chooses, reports."""
     from drake_standup.cluster import run_on_cluster
-    from drake_standup.outputs import write_json
+    from drake_standup.records import write_json
 
     out_dir = Path(out_dir)
     runs_dir = out_dir / "runs"

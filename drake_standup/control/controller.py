@@ -1,0 +1,293 @@
+"""WholeBodyController: the momentum-based whole-body torque controller (SPEC 2, 3, 7).
+
+A thin LeafSystem: every period_s it reads the controller's model at the robot's state
+(terms, control/model.py), the tick's task references (control/references.py) and the
+contact commands (control/schedule.py), solves one QP over [contact wrenches, vdot] with
+the task objects of control/tasks.py (control/qp.py) and holds the joint torques. On a
+failed QP the last torques stay.
+
+Ports
+    terms               abstract RobotTerms
+    task_references     abstract TaskReferences
+    contact_commands    abstract ContactCommands
+    -> actuation        (nu) joint torques, actuator order, N m (zero-order held)
+    -> diagnostics      DIAGNOSTICS
+    -> commanded_normal_forces_N (5) DIAGNOSTICS' commanded_normal_force_N
+
+One QP program per set of active contacts (its size, and so its solve time, shrinks once
+the seat is released), built at the first tick that needs it (make_program); the tasks
+active in each stand-up state come from the phase table (the stance tasks where a phase
+has stance).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.common.value import Value
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import BasicVector, Context, DiscreteValues, LeafSystem
+
+from drake_standup.config import ControllerConfig
+from drake_standup.control.contacts import NORMAL, WRENCH_SIZE, ContactSpec
+from drake_standup.control.model import ControllerJoints
+from drake_standup.control.qp import ContactCommands as QpContactCommands
+from drake_standup.control.qp import ContactMap, QpSolution, WholeBodyQp
+from drake_standup.control.references import joint_values
+from drake_standup.control.schedule import CONTACTS, HOLDS, ContactCommands
+from drake_standup.control.tasks import (
+    BaseOrientationTask,
+    CopCenteringTask,
+    JointLimitBounds,
+    MomentumTask,
+    PostureTask,
+    StancePostureTask,
+)
+from drake_standup.payloads import VectorLayout
+from drake_standup.phases import PhaseTable
+
+DIAGNOSTICS = VectorLayout(
+    ("qp_ok", 1),  # 1 if this tick's QP succeeded, else 0 (torques held)
+    ("qp_failures", 1),  # failed QPs since the start
+    ("solve_time_s", 1),  # QP solver time this tick
+    ("tick_time_s", 1),  # the whole discrete update
+    ("commanded_normal_force_N", len(CONTACTS)),  # f_z asked of CONTACTS (NaN: failed)
+    ("joint_limit_slack", 1),  # largest slack of the soft joint-limit bounds, rad/s^2
+    ("qp_relaxed", 1),  # ticks solved only with the contacts relaxed, since the start
+)
+# Columns of WholeBodyController.timing_s().
+TIMING = ("inputs_s", "kinematics_s", "assembly_s", "solve_s", "total_s")
+_COMMANDED = DIAGNOSTICS["commanded_normal_force_N"]
+
+
+@dataclass(frozen=True)
+class Program:
+    """A WholeBodyQp over some active contacts, and how CONTACTS map into it."""
+
+    qp: WholeBodyQp
+    contact_index: np.ndarray  # of each of its contacts in CONTACTS
+    partially_held: dict[str, dict[int, np.ndarray]]  # HOLDS -> ContactCommands'
+
+
+def make_program(
+    specs: list[ContactSpec],
+    active: tuple[bool, ...],
+    plant: MultibodyPlant,
+    joints: ControllerJoints,
+    config: ControllerConfig,
+    stance_states: set[int],
+    torque_limit_Nm: float,
+) -> Program:
+    """The QP over the active contacts with the controller's tasks (control/tasks.py):
+    momentum, CoP centering, posture; in the stance states the legs' posture and the
+    arms' (growing with the stance); base orientation; soft joint-limit bounds."""
+    contacts = [spec for spec, on in zip(specs, active, strict=True) if on]
+    contact_map = ContactMap(contacts, plant.num_velocities())
+    layout = contact_map.layout
+
+    def weights(table: dict[str, float], key: str, default: float) -> np.ndarray:
+        return joint_values(joints.names, table, key, default)
+
+    def posture(kind, table, name, states=None):
+        return kind(
+            layout,
+            joints.q_indices,
+            joints.v_indices,
+            table,
+            config.posture_kp_per_s2,
+            config.posture_damping_ratio,
+            name=name,
+            active_states=states,
+        )
+
+    tasks = [
+        MomentumTask(
+            layout, contact_map, plant.gravity_field().gravity_vector(), config.momentum_weight
+        ),
+        CopCenteringTask(layout, contacts, config.cop_centering_weight),
+        posture(
+            PostureTask,
+            weights(
+                config.posture_weight_by_joint, "posture_weight_by_joint", config.posture_weight
+            ),
+            "posture",
+        ),
+        posture(
+            PostureTask,
+            weights(config.stance_posture_weight_by_joint, "stance_posture_weight_by_joint", 0.0),
+            "stance_posture",
+            stance_states,
+        ),
+        posture(
+            StancePostureTask,
+            weights(config.stance_arm_weight_by_joint, "stance_arm_weight_by_joint", 0.0),
+            "stance_arms",
+            stance_states,
+        ),
+        BaseOrientationTask(
+            layout,
+            config.base_orientation_weight,
+            config.base_orientation_kp_per_s2,
+            config.base_orientation_damping_ratio,
+        ),
+    ]
+    qp = WholeBodyQp(
+        contact_map,
+        plant.MakeActuationMatrix(),
+        torque_limit_Nm=torque_limit_Nm,
+        torque_weight=config.torque_weight,
+        wrench_weight=config.wrench_weight,
+        acceleration_weight=config.acceleration_weight,
+        tasks=tasks,
+        soft_bounds=JointLimitBounds(
+            joints.q_indices,
+            joints.v_indices,
+            joints.q_min,
+            joints.q_max,
+            config.joint_limit_horizon_s,
+        ),
+        soft_bound_weight=config.joint_limit_weight,
+        solver=config.qp_solver,
+    )
+    # The seat's held rows: all (held), all but its pitch about the hip axis (hinged:
+    # alpha_y in C), none (free).
+    seat = [c for c, spec in enumerate(contacts) if spec.frame == "seat"]
+    hinged = np.ones(WRENCH_SIZE, dtype=bool)
+    hinged[1] = False
+    rows = {"held": None, "hinged": hinged, "free": np.zeros(WRENCH_SIZE, dtype=bool)}
+    return Program(
+        qp=qp,
+        contact_index=np.array([CONTACTS.index(spec.frame) for spec in contacts]),
+        partially_held={
+            hold: {} if rows[hold] is None else {c: rows[hold] for c in seat} for hold in HOLDS
+        },
+    )
+
+
+@dataclass
+class ControllerTick:
+    """One tick's solution and what it took."""
+
+    solution: QpSolution  # for the active contacts only
+    normal_forces_N: np.ndarray  # commanded f_z of every contact (CONTACTS), 0 if inactive
+    inputs_s: float  # evaluating the references and commands (and the systems behind them)
+    kinematics_s: float  # evaluating the terms (the model, and the systems behind it)
+    assembly_s: float  # the QP's tasks and matrices
+
+
+class WholeBodyController(LeafSystem):
+    """Momentum-based whole-body torque controller (module docstring)."""
+
+    def __init__(
+        self,
+        plant: MultibodyPlant,
+        specs: list[ContactSpec],
+        joints: ControllerJoints,
+        config: ControllerConfig,
+        table: PhaseTable,
+        period_s: float,
+    ):
+        super().__init__()
+        if [spec.frame for spec in specs] != list(CONTACTS):
+            raise ValueError(f"contact specs must be {CONTACTS}")
+        actuators = plant.GetJointActuatorIndices()
+        torque_limit = config.torque_limit_Nm or min(
+            plant.get_joint_actuator(i).effort_limit() for i in actuators
+        )
+        stance = {k for k, phase in enumerate(table, start=1) if phase.stance}
+        self._make = lambda active: make_program(
+            specs, active, plant, joints, config, stance, torque_limit
+        )
+        self._programs: dict[tuple[bool, ...], Program] = {}
+        self._timing: list[tuple[float, ...]] = []
+        self._terms = self.DeclareAbstractInputPort("terms", Value[object](None))
+        self._references = self.DeclareAbstractInputPort("task_references", Value[object](None))
+        self._commands = self.DeclareAbstractInputPort("contact_commands", Value[object](None))
+        self._actuation = self.DeclareDiscreteState(len(actuators))
+        self._diagnostics = self.DeclareDiscreteState(DIAGNOSTICS.size)
+        self.DeclareStateOutputPort("actuation", self._actuation)
+        self.DeclareStateOutputPort("diagnostics", self._diagnostics)
+        self.DeclareVectorOutputPort(
+            "commanded_normal_forces_N",
+            len(CONTACTS),
+            self._CalcCommanded,
+            prerequisites_of_calc={self.discrete_state_ticket(self._diagnostics)},
+        )
+        # Initialization event: the plant's first step already sees computed torques.
+        self.DeclareInitializationDiscreteUpdateEvent(self._Update)
+        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
+
+    def timing_s(self) -> np.ndarray:
+        """Per-tick compute times since construction (or reset_timing), (ticks, 5), in
+        TIMING's columns."""
+        return np.array(self._timing).reshape(-1, len(TIMING))
+
+    def reset_timing(self) -> None:
+        self._timing.clear()
+
+    def program(self, active: tuple[bool, ...]) -> Program:
+        """The QP over the active contacts (built when first needed)."""
+        program = self._programs.get(active)
+        if program is None:
+            program = self._programs[active] = self._make(active)
+        return program
+
+    def CalcTick(self, context: Context) -> ControllerTick:
+        """Solves the QP for the inputs in context."""
+        t_start = time.perf_counter()
+        terms = self._terms.Eval(context)
+        t_terms = time.perf_counter()
+        references = self._references.Eval(context)
+        commands: ContactCommands = self._commands.Eval(context)
+        t_inputs = time.perf_counter()
+        program = self.program(commands.active)
+        index = program.contact_index
+        solution = program.qp.solve(
+            terms,
+            references,
+            QpContactCommands(
+                commands.min_normal_force_N[index],
+                commands.max_normal_force_N[index],
+                program.partially_held[commands.seat_hold],
+            ),
+        )
+        normal_forces_N = np.zeros(len(CONTACTS))
+        normal_forces_N[index] = solution.F_C[:, NORMAL]
+        return ControllerTick(
+            solution=solution,
+            normal_forces_N=normal_forces_N,
+            inputs_s=t_inputs - t_terms,
+            kinematics_s=t_terms - t_start,
+            assembly_s=solution.assembly_s,
+        )
+
+    def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
+        t_start = time.perf_counter()
+        tick = self.CalcTick(context)
+        solution = tick.solution
+        if solution.ok:  # on failure the last torques stay in the actuation state
+            discrete_state.set_value(self._actuation, solution.tau)
+        before = DIAGNOSTICS.unpack(context.get_discrete_state(self._diagnostics).value())
+        total_s = time.perf_counter() - t_start
+        discrete_state.set_value(
+            self._diagnostics,
+            DIAGNOSTICS.pack(
+                qp_ok=float(solution.ok),
+                qp_failures=before["qp_failures"] + (0.0 if solution.ok else 1.0),
+                solve_time_s=solution.solve_s,
+                tick_time_s=total_s,
+                commanded_normal_force_N=tick.normal_forces_N if solution.ok else np.nan,
+                joint_limit_slack=float(np.abs(solution.slack).max())
+                if solution.slack.size
+                else 0.0,
+                qp_relaxed=before["qp_relaxed"] + float(solution.relaxed),
+            ),
+        )
+        self._timing.append(
+            (tick.inputs_s, tick.kinematics_s, tick.assembly_s, solution.solve_s, total_s)
+        )
+
+    def _CalcCommanded(self, context: Context, output: BasicVector) -> None:
+        output.SetFromVector(context.get_discrete_state(self._diagnostics).value()[_COMMANDED])

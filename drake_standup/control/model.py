@@ -1,0 +1,139 @@
+"""ControllerModel: the controller's model of the robot, evaluated once per tick.
+
+Its output, RobotTerms (control/terms.py: M, h, the CoM and the centroidal momentum, the
+contact frames' and the hands' Jacobians), is what the task references and the
+whole-body QP both read, so the dynamics are computed once a tick and both see the same
+numbers. Only the frames a tick needs are computed: the active contacts' (the contact
+commands say which), and the hands' while they are pulled. Every body's mass is scaled by
+the mass_scale input (control/mass.py).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.common.value import Value
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import Context, LeafSystem
+
+from drake_standup.caching import declare_cached
+from drake_standup.config import ControllerConfig
+from drake_standup.control.contacts import ContactSpec
+from drake_standup.control.schedule import CONTACTS, ContactCommands
+from drake_standup.control.terms import RobotKinematics, RobotTerms
+from drake_standup.payloads import HAND_WRENCHES
+from drake_standup.robot import Robot, actuated_joints
+
+HANDS = ("l_hand", "r_hand")
+
+
+def contact_specs(
+    plant: MultibodyPlant, robot: Robot, config: ControllerConfig
+) -> list[ContactSpec]:
+    """The controller's contacts (CONTACTS): the seat, held at the hip axis (the mid-point
+    of controller.seat_hinge_joints' frames), both thighs (point forces, pinned by the
+    others), both soles; friction and CoP boxes from the config."""
+    seat = robot.frame(plant, "seat")
+    context = plant.CreateDefaultContext()
+    p_SeatHinge = np.mean(
+        [
+            plant.GetJointByName(name, robot.model_instance)
+            .frame_on_parent()
+            .CalcPose(context, seat)
+            .translation()
+            for name in config.seat_hinge_joints
+        ],
+        axis=0,
+    )
+    friction = {
+        "friction_coefficient": config.friction_coefficient,
+        "torsional_friction_coefficient": config.torsional_friction_coefficient_m,
+    }
+    seat_box = {"cop_x_m": tuple(config.seat_cop_x_m), "cop_y_m": tuple(config.seat_cop_y_m)}
+    foot_box = {"cop_x_m": tuple(config.foot_cop_x_m), "cop_y_m": tuple(config.foot_cop_y_m)}
+    return [
+        ContactSpec("seat", **friction, **seat_box, hold_point_m=tuple(p_SeatHinge.tolist())),
+        ContactSpec("l_thigh", **friction, point=True, constrained=False),
+        ContactSpec("r_thigh", **friction, point=True, constrained=False),
+        ContactSpec("l_sole", **friction, **foot_box),
+        ContactSpec("r_sole", **friction, **foot_box),
+    ]
+
+
+@dataclass(frozen=True)
+class ControllerJoints:
+    """The actuated joints, in actuator order, as the controller indexes them: the chair
+    and floor are welded, so the robot's q and v are the plant's."""
+
+    names: list[str]
+    q_indices: np.ndarray  # index of each joint's angle in q
+    v_indices: np.ndarray  # index of each joint's rate in v
+    q_min: np.ndarray  # position limits, rad
+    q_max: np.ndarray
+
+    @classmethod
+    def of(cls, plant: MultibodyPlant, robot: Robot) -> ControllerJoints:
+        actuated = actuated_joints(plant, robot.model_instance)
+        joints = [plant.GetJointByName(name, robot.model_instance) for name in actuated.names]
+        return cls(
+            names=actuated.names,
+            q_indices=actuated.q_index,
+            v_indices=actuated.v_index,
+            q_min=np.array([joint.position_lower_limits()[0] for joint in joints]),
+            q_max=np.array([joint.position_upper_limits()[0] for joint in joints]),
+        )
+
+
+def active_frames(specs: list[ContactSpec], active: tuple[bool, ...]) -> list[str]:
+    """The frames of the active contacts, in CONTACTS' order (the QP's)."""
+    return [spec.frame for spec, on in zip(specs, active, strict=True) if on]
+
+
+class ControllerModel(LeafSystem):
+    """Inputs robot_state ([q; v]), mass_scale (1), contact_commands (abstract
+    ContactCommands), hand_wrenches_W (12). Output terms (abstract RobotTerms)."""
+
+    def __init__(self, plant: MultibodyPlant, robot: Robot, specs: list[ContactSpec]):
+        super().__init__()
+        if [spec.frame for spec in specs] != list(CONTACTS):
+            raise ValueError(f"contact specs must be {CONTACTS}")
+        self.specs = specs
+        self.kinematics = RobotKinematics(
+            plant,
+            robot,
+            held_frames=[spec.frame for spec in specs if spec.constrained],
+            other_frames=[spec.frame for spec in specs if not spec.constrained] + list(HANDS),
+            hold_points_m={spec.frame: spec.hold_point_m for spec in specs},
+        )
+        nx = plant.num_positions(robot.model_instance) + plant.num_velocities(robot.model_instance)
+        self._state = self.DeclareVectorInputPort("robot_state", nx)
+        self._scale = self.DeclareVectorInputPort("mass_scale", 1)
+        self._commands = self.DeclareAbstractInputPort("contact_commands", Value[object](None))
+        self._hands = self.DeclareVectorInputPort("hand_wrenches_W", HAND_WRENCHES.size)
+        self._frames: dict[tuple[bool, ...], list[str]] = {}
+        terms = declare_cached(
+            self,
+            "terms",
+            self._calc,
+            {p.ticket() for p in (self._state, self._scale, self._commands, self._hands)},
+        )
+        self.DeclareAbstractOutputPort(
+            "terms", lambda: Value[object](None), self._output(terms), {terms.ticket()}
+        )
+
+    @staticmethod
+    def _output(entry):
+        def calc(context: Context, output: Value) -> None:
+            output.set_value(entry.Eval(context))
+
+        return calc
+
+    def _calc(self, context: Context) -> RobotTerms:
+        self.kinematics.set_mass_scale(float(self._scale.Eval(context)[0]))
+        commands: ContactCommands = self._commands.Eval(context)
+        frames = self._frames.get(commands.active)
+        if frames is None:
+            frames = self._frames[commands.active] = active_frames(self.specs, commands.active)
+        pulled = bool(self._hands.Eval(context).any())
+        return self.kinematics.calc(self._state.Eval(context), frames, HANDS if pulled else ())
