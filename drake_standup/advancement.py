@@ -67,15 +67,16 @@ def lead(com: np.ndarray, x_d: np.ndarray, tangent: np.ndarray) -> float:
 
 def psi_dot_law(
     config: AdvancementConfig,
-    com_velocity: np.ndarray,
+    com_velocity: np.ndarray | Callable[[], np.ndarray],
     omega_f: np.ndarray,
     tangent: np.ndarray,
     lead_m: float | Callable[[], float] = 0.0,
-    progress: float = 0.0,
+    progress: float | Callable[[], float] = 0.0,
 ) -> tuple[float, float]:
     """(psi_dot, alpha) by the configured update law; lead_m feeds the lead gate
     (or a function giving it, called only when the gate decides); progress: how far
-    along its segment the reference is (0-1), for the taper at the segment's end.
+    along its segment the reference is (0-1), for the taper at the segment's end. The
+    CoM velocity and the progress may be functions too, called only where the law acts.
 
     psi_dot = 1 + w(alpha) g(lead) (clip(ratio, 1, upper) - 1): the paper's law where
     the help is full (w = g = 1), psi = t where there is none; the weights grade the
@@ -83,6 +84,8 @@ def psi_dot_law(
     alpha = helpfulness(tangent, omega_f, config.eps)
     if not config.enabled or alpha <= config.alpha_min_mps2:
         return 1.0, alpha
+    if callable(progress):
+        progress = progress()
     weight = 1.0
     if config.alpha_full_mps2 > config.alpha_min_mps2:
         weight = min(
@@ -101,6 +104,8 @@ def psi_dot_law(
             if lead_m <= -config.lag_tolerance_m:
                 return 1.0, alpha
             weight *= 1.0 + lead_m / config.lag_tolerance_m
+    if callable(com_velocity):
+        com_velocity = com_velocity()
     if config.law == "tangent":
         ratio = float(com_velocity @ tangent) / (float(tangent @ tangent) + config.eps)
     else:
@@ -110,7 +115,8 @@ def psi_dot_law(
 
 
 class TrajectoryAdvancement(LeafSystem):
-    """Inputs com_W, com_velocity_W, omega_f_W, x_d_W, path_tangent_W (3 each).
+    """Inputs com_W, com_velocity_W, omega_f_W, x_d_W, path_tangent_W (3 each),
+    path_progress (1) and advances (1: the phase lets psi advance, phases.py).
 
     Continuous state [psi, psi_dot]: the law sets the rate psi_dot tends to,
     with time constant psi_ddot_filter_s, and psi integrates psi_dot. The
@@ -134,11 +140,11 @@ class TrajectoryAdvancement(LeafSystem):
         self._omega_f = self.DeclareVectorInputPort("omega_f_W", 3)
         self._x_d = self.DeclareVectorInputPort("x_d_W", 3)
         self._tangent = self.DeclareVectorInputPort("path_tangent_W", 3)
-        # Unconnected (unit tests): no taper.
+        # How far along its segment the reference is (0-1), for the taper.
         self._progress = self.DeclareVectorInputPort("path_progress", 1)
         # Whether the stand-up's phase lets psi advance (> 0.5; phases.py: advances):
         # not while balancing seated or returning to the seat after a hindering pull,
-        # which a backward pull helps (docs/design.md). Unconnected: it always may.
+        # which a backward pull helps (docs/design.md).
         self._advances = self.DeclareVectorInputPort("advances", 1)
         self.DeclareVectorOutputPort(
             "psi",
@@ -177,16 +183,17 @@ class TrajectoryAdvancement(LeafSystem):
 
     def _calc_law(self, context: Context) -> tuple[float, float]:
         tangent = self._tangent.Eval(context)
-        if self._advances.HasValue(context) and self._advances.Eval(context)[0] < 0.5:
+        if self._advances.Eval(context)[0] < 0.5:
             tangent = np.zeros(3)  # a phase that holds psi = t: nothing to advance along
+        # The velocity, the lead and the progress only while the interaction helps (a
+        # few seconds of a stand-up).
         return psi_dot_law(
             self._config,
-            self._v.Eval(context),
+            lambda: self._v.Eval(context),
             self._omega_f.Eval(context),
             tangent,
-            # Only while the interaction helps (a few seconds of a stand-up).
             lambda: lead(self._com.Eval(context), self._x_d.Eval(context), tangent),
-            self._progress.Eval(context)[0] if self._progress.HasValue(context) else 0.0,
+            lambda: self._progress.Eval(context)[0],
         )
 
     def _psi_ddot(self, context: Context) -> float:

@@ -47,7 +47,14 @@ class ContactForceReporter(LeafSystem):
         self.pad_names = list(pad_names)
         self._rows = {gid: i for i, gid in enumerate(pad_ids)}
         self._results = self.DeclareAbstractInputPort("contact_results", Value(ContactResults()))
-        self.DeclareVectorOutputPort("pad_forces_W", 3 * len(self.pad_names), self._CalcForces)
+        # The contact results alone: not recomputed at the loggers' and visualizers' times
+        # between the plant's steps.
+        self.DeclareVectorOutputPort(
+            "pad_forces_W",
+            3 * len(self.pad_names),
+            self._CalcForces,
+            prerequisites_of_calc={self._results.ticket()},
+        )
 
     def _CalcForces(self, context: Context, output) -> None:
         results = self._results.Eval(context)

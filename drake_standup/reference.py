@@ -65,12 +65,9 @@ class CoMReferenceGenerator(LeafSystem):
         self._psi_ddot = self.DeclareVectorInputPort("psi_ddot", 1)
         self._segment = self.DeclareVectorInputPort("segment", SEGMENT_SIZE)
         # The path depends on psi and the segment only: evaluated once per
-        # change of them for all three outputs.
+        # change of them for all four outputs.
         self._path = declare_cached(
-            self,
-            "path at psi",
-            lambda context: path(self._segment.Eval(context), self._psi.Eval(context)[0]),
-            {self._psi.ticket(), self._segment.ticket()},
+            self, "path at psi", self._calc_path, {self._psi.ticket(), self._segment.ticket()}
         )
         path_only = {self._path.ticket()}
         self.DeclareVectorOutputPort(
@@ -86,14 +83,18 @@ class CoMReferenceGenerator(LeafSystem):
             "path_tangent_W", 3, self._CalcTangent, prerequisites_of_calc=path_only
         )
         self.DeclareVectorOutputPort(
-            "path_progress",
-            1,
-            self._CalcProgress,
-            prerequisites_of_calc={self._psi.ticket(), self._segment.ticket()},
+            "path_progress", 1, self._CalcProgress, prerequisites_of_calc=path_only
         )
 
+    def _calc_path(self, context: Context) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """x_d, d_psi x_d, d2_psi x_d and the progress along the segment at psi."""
+        segment = self._segment.Eval(context)
+        psi = self._psi.Eval(context)[0]
+        progress = min(max((psi - segment[0]) / segment[1], 0.0), 1.0)
+        return (*path(segment, psi), progress)
+
     def _CalcReference(self, context: Context, output: BasicVector) -> None:
-        x_d, d_x, dd_x = self._path.Eval(context)
+        x_d, d_x, dd_x, _ = self._path.Eval(context)
         psi_dot = self._psi_dot.Eval(context)[0]
         psi_ddot = self._psi_ddot.Eval(context)[0]
         output.SetFromVector(
@@ -109,6 +110,4 @@ class CoMReferenceGenerator(LeafSystem):
         output.SetFromVector(d_x)
 
     def _CalcProgress(self, context: Context, output: BasicVector) -> None:
-        segment = self._segment.Eval(context)
-        psi = self._psi.Eval(context)[0]
-        output.SetAtIndex(0, min(max((psi - segment[0]) / segment[1], 0.0), 1.0))
+        output.SetAtIndex(0, self._path.Eval(context)[3])

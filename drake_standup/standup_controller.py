@@ -1,15 +1,15 @@
 """make_standup_controller(scenario, station): the stand-up controller, as one diagram.
 
     state machine ──mode──► contact schedule ──commands──┬──► controller model ──terms──┐
-       │ state, segment, advances                        │       ▲ mass_scale           │
-       ▼                                                 │  mass estimate               ▼
+       │ state, segment, advances                        │   (weighs the robot seated)  │
+       ▼                                                 │                              ▼
     advancement ◄──► CoM reference ──com_reference──► task references ──► whole-body controller
                      (psi, x_d(psi))                                 commands ──┘  │ torques
 
 The state machine (state_machine.py) follows the phase table (phases.py); the
 advancement (advancement.py) integrates psi; the CoM reference (reference.py) is x_d(psi)
-and its derivatives; the mass estimate (control/mass.py), the contact schedule
-(control/schedule.py), the controller's model (control/model.py) and the task references
+and its derivatives; the contact schedule (control/schedule.py), the controller's model
+with its mass estimate (control/model.py, control/mass.py) and the task references
 (control/references.py) feed the whole-body QP (control/controller.py).
 
 Inputs (a station's outputs of the same names, station.py): robot_state, pad_forces_W,
@@ -30,7 +30,6 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 from drake_standup.advancement import TrajectoryAdvancement
 from drake_standup.config import Scenario
 from drake_standup.control.controller import WholeBodyController
-from drake_standup.control.mass import MassEstimator
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
 from drake_standup.control.references import (
@@ -62,14 +61,12 @@ _WIRES = [
     ("com_reference", "psi_dot", "advancement", "psi_dot"),
     ("com_reference", "psi_ddot", "advancement", "psi_ddot"),
     ("com_reference", "segment", "state_machine", "segment"),
-    ("mass_estimate", "pads_vertical_force_N", "", "pads_vertical_force_N"),
-    ("mass_estimate", "hand_wrenches_W", "", "hand_wrenches_W"),
-    ("mass_estimate", "standup_state", "state_machine", "standup_state"),
     ("contact_schedule", "mode", "state_machine", "mode"),
     ("contact_schedule", "seat_pad_normal_forces_N", "", "seat_pad_normal_forces_N"),
     ("contact_schedule", "commanded_normal_forces_N", "controller", "commanded_normal_forces_N"),
     ("controller_model", "robot_state", "", "robot_state"),
-    ("controller_model", "mass_scale", "mass_estimate", "mass_scale"),
+    ("controller_model", "pads_vertical_force_N", "", "pads_vertical_force_N"),
+    ("controller_model", "standup_state", "state_machine", "standup_state"),
     ("controller_model", "contact_commands", "contact_schedule", "contact_commands"),
     ("controller_model", "hand_wrenches_W", "", "hand_wrenches_W"),
     ("task_references", "terms", "controller_model", "terms"),
@@ -95,7 +92,7 @@ _OUTPUTS = {
     "segment": ("state_machine", "segment"),
     "entry_times_s": ("state_machine", "entry_times_s"),
     "lean_W": ("task_references", "lean_W"),
-    "mass_estimate": ("mass_estimate", "mass_estimate"),
+    "mass_estimate": ("controller_model", "mass_estimate"),
 }
 
 
@@ -113,22 +110,14 @@ def make_standup_controller(scenario: Scenario, station: Station) -> StandupCont
     specs = contact_specs(plant, robot, config)
     joints = ControllerJoints.of(plant, robot)
     schedule = StandupSchedule(table, config, joints.names, joints.q_min, joints.q_max)
-    model_mass_kg = plant.CalcTotalMass(plant.CreateDefaultContext(), [robot.model_instance])
     systems = {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()
         ),
         "advancement": TrajectoryAdvancement(scenario.advancement),
         "com_reference": CoMReferenceGenerator(),
-        "mass_estimate": MassEstimator(
-            model_mass_kg,
-            g,
-            period_s,
-            config.mass_estimation_filter_s,
-            config.mass_scale_bounds,
-        ),
         "contact_schedule": ContactScheduler(config, table, period_s),
-        "controller_model": ControllerModel(plant, robot, specs),
+        "controller_model": ControllerModel(plant, robot, specs, config, period_s),
         "task_references": TaskReferenceGenerator(
             ReferenceGenerator(config, schedule, as_slice(joints.q_indices), period_s, g),
             period_s,

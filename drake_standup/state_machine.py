@@ -319,22 +319,32 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
 SEAT_LOADS = ("buttocks", "thighs", "thighs")
 
 
-def seat_loads(mode: StandupMode, t: float, table: PhaseTable) -> np.ndarray:
+def seat_releases(table: PhaseTable) -> list[tuple[int, float, list[int]]]:
+    """(the state whose entry starts the release, over how long, s, the entries of
+    SEAT_LOADS) of each pad group the table releases."""
+    releases = []
+    for pads in SEAT_PADS:
+        state = table.unloading_phase(pads)
+        if state is not None:
+            rows = [i for i, name in enumerate(SEAT_LOADS) if name == pads]
+            releases.append((state, table.phase(state).unload_s, rows))
+    return releases
+
+
+def seat_loads(
+    mode: StandupMode, t: float, table: PhaseTable | list[tuple[int, float, list[int]]]
+) -> np.ndarray:
     """What is left of the load of the buttocks and of each thigh (SEAT_LOADS), as a
     fraction of their load when their release began; NaN while the pad is seated. A pad
     group is released from the entry of the phase that lists it in unload (from then on,
     until the robot is back in an earlier phase), smoothstep from 1 to 0 over its
-    unload_s."""
+    unload_s. table: the phase table, or its seat_releases."""
+    releases = seat_releases(table) if isinstance(table, PhaseTable) else table
     loads = np.full(len(SEAT_LOADS), math.nan)
-    for pads in SEAT_PADS:
-        state = table.unloading_phase(pads)
-        if state is None or mode.state < state:
-            continue
-        over_s = table.phase(state).unload_s
-        left = (
-            0.0 if over_s <= 0 else smoothstep(1.0 - (t - mode.entry_times_s[state - 1]) / over_s)
-        )
-        loads[[i for i, name in enumerate(SEAT_LOADS) if name == pads]] = left
+    for state, over_s, rows in releases:
+        if mode.state >= state:
+            since = t - mode.entry_times_s[state - 1]
+            loads[rows] = 0.0 if over_s <= 0 else smoothstep(1.0 - since / over_s)
     return loads
 
 

@@ -60,6 +60,7 @@ DIAGNOSTICS = VectorLayout(
 # Columns of WholeBodyController.timing_s().
 TIMING = ("inputs_s", "kinematics_s", "assembly_s", "solve_s", "total_s")
 _COMMANDED = DIAGNOSTICS["commanded_normal_force_N"]
+_FAILURES, _RELAXED = DIAGNOSTICS.index("qp_failures"), DIAGNOSTICS.index("qp_relaxed")
 
 
 @dataclass(frozen=True)
@@ -269,20 +270,20 @@ class WholeBodyController(LeafSystem):
         solution = tick.solution
         if solution.ok:  # on failure the last torques stay in the actuation state
             discrete_state.set_value(self._actuation, solution.tau)
-        before = DIAGNOSTICS.unpack(context.get_discrete_state(self._diagnostics).value())
+        before = context.get_discrete_state(self._diagnostics).value()
         total_s = time.perf_counter() - t_start
         discrete_state.set_value(
             self._diagnostics,
             DIAGNOSTICS.pack(
                 qp_ok=float(solution.ok),
-                qp_failures=before["qp_failures"] + (0.0 if solution.ok else 1.0),
+                qp_failures=before[_FAILURES] + (0.0 if solution.ok else 1.0),
                 solve_time_s=solution.solve_s,
                 tick_time_s=total_s,
                 commanded_normal_force_N=tick.normal_forces_N if solution.ok else np.nan,
                 joint_limit_slack=float(np.abs(solution.slack).max())
                 if solution.slack.size
                 else 0.0,
-                qp_relaxed=before["qp_relaxed"] + float(solution.relaxed),
+                qp_relaxed=before[_RELAXED] + float(solution.relaxed),
             ),
         )
         self._timing.append(

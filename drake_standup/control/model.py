@@ -1,11 +1,11 @@
-"""ControllerModel: the controller's model of the robot, evaluated once per tick.
+"""The controller's model of the robot: its contacts, its joints, and ControllerModel.
 
-Its output, RobotTerms (control/terms.py: M, h, the CoM and the centroidal momentum, the
-contact frames' and the hands' Jacobians), is what the task references and the
-whole-body QP both read, so the dynamics are computed once a tick and both see the same
-numbers. Only the frames a tick needs are computed: the active contacts' (the contact
-commands say which), and the hands' while they are pulled. Every body's mass is scaled by
-the mass_scale input (control/mass.py).
+ControllerModel's output, RobotTerms (control/terms.py: M, h, the CoM and the centroidal
+momentum, the contact frames' and the hands' Jacobians), is what the task references and
+the whole-body QP both read, so the dynamics are computed once a tick and both see the
+same numbers. Only the frames a tick needs are computed: the active contacts' (the
+contact commands say which), and the hands' while they are pulled. Every body's mass
+follows the robot's weighing while seated (control/mass.py).
 """
 
 from __future__ import annotations
@@ -15,17 +15,20 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.common.value import Value
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.systems.framework import Context, LeafSystem
+from pydrake.systems.framework import BasicVector, Context, DiscreteValues, LeafSystem
 
 from drake_standup.caching import declare_cached
 from drake_standup.config import ControllerConfig
 from drake_standup.control.contacts import ContactSpec
+from drake_standup.control.mass import next_mass_state
 from drake_standup.control.schedule import CONTACTS, ContactCommands
 from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.payloads import HAND_WRENCHES
 from drake_standup.robot import Robot, actuated_joints
 
 HANDS = ("l_hand", "r_hand")
+_F_Z_LEFT = HAND_WRENCHES["f_l"].start + 2
+_F_Z_RIGHT = HAND_WRENCHES["f_r"].start + 2
 
 
 def contact_specs(
@@ -91,10 +94,24 @@ def active_frames(specs: list[ContactSpec], active: tuple[bool, ...]) -> list[st
 
 
 class ControllerModel(LeafSystem):
-    """Inputs robot_state ([q; v]), mass_scale (1), contact_commands (abstract
-    ContactCommands), hand_wrenches_W (12). Output terms (abstract RobotTerms)."""
+    """The controller's model at the robot's state, once a tick, and its weighing.
 
-    def __init__(self, plant: MultibodyPlant, robot: Robot, specs: list[ContactSpec]):
+    Inputs robot_state ([q; v]), contact_commands (abstract ContactCommands),
+    hand_wrenches_W (12, payloads.HAND_WRENCHES), pads_vertical_force_N (1: the vertical
+    force on all the robot's pads), standup_state (1). Outputs terms (abstract
+    RobotTerms) and mass_estimate (1: the mass estimate after the last tick, for
+    logging). Discrete state: the mass estimate's [estimate, began, model's scale]
+    (control/mass.py: next_mass_state), updated every period_s.
+    """
+
+    def __init__(
+        self,
+        plant: MultibodyPlant,
+        robot: Robot,
+        specs: list[ContactSpec],
+        config: ControllerConfig,
+        period_s: float,
+    ):
         super().__init__()
         if [spec.frame for spec in specs] != list(CONTACTS):
             raise ValueError(f"contact specs must be {CONTACTS}")
@@ -106,21 +123,36 @@ class ControllerModel(LeafSystem):
             other_frames=[spec.frame for spec in specs if not spec.constrained] + list(HANDS),
             hold_points_m={spec.frame: spec.hold_point_m for spec in specs},
         )
+        g = -plant.gravity_field().gravity_vector()[2]
+        filter_s = config.mass_estimation_filter_s
+        self._mass = (
+            self.kinematics.nominal_mass_kg * g,
+            min(period_s / filter_s, 1.0) if filter_s > 0.0 else 0.0,
+            tuple(config.mass_scale_bounds),
+        )
         nx = plant.num_positions(robot.model_instance) + plant.num_velocities(robot.model_instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
-        self._scale = self.DeclareVectorInputPort("mass_scale", 1)
         self._commands = self.DeclareAbstractInputPort("contact_commands", Value[object](None))
         self._hands = self.DeclareVectorInputPort("hand_wrenches_W", HAND_WRENCHES.size)
+        self._support = self.DeclareVectorInputPort("pads_vertical_force_N", 1)
+        self._standup_state = self.DeclareVectorInputPort("standup_state", 1)
+        self._weighing = self.DeclareDiscreteState(np.array([1.0, 0.0, 1.0]))
         self._frames: dict[tuple[bool, ...], list[str]] = {}
-        terms = declare_cached(
-            self,
-            "terms",
-            self._calc,
-            {p.ticket() for p in (self._state, self._scale, self._commands, self._hands)},
+        self._next_mass = declare_cached(
+            self, "mass state", self._calc_mass, {self.all_sources_ticket()}
         )
+        terms = declare_cached(self, "terms", self._calc, {self.all_sources_ticket()})
         self.DeclareAbstractOutputPort(
             "terms", lambda: Value[object](None), self._output(terms), {terms.ticket()}
         )
+        self.DeclareVectorOutputPort(
+            "mass_estimate",
+            1,
+            self._CalcEstimate,
+            prerequisites_of_calc={self.discrete_state_ticket(self._weighing)},
+        )
+        self.DeclareInitializationDiscreteUpdateEvent(self._Update)
+        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
 
     @staticmethod
     def _output(entry):
@@ -129,11 +161,26 @@ class ControllerModel(LeafSystem):
 
         return calc
 
+    def _calc_mass(self, context: Context) -> np.ndarray:
+        state = context.get_discrete_state(self._weighing).value()
+        if state[1]:  # the stand-up has begun: frozen
+            return state.copy()
+        hands = self._hands.Eval(context)
+        weight_N = float(self._support.Eval(context)[0]) + hands[_F_Z_LEFT] + hands[_F_Z_RIGHT]
+        standup_state = min(max(int(round(self._standup_state.Eval(context)[0])), 1), 4)
+        return next_mass_state(state, standup_state, weight_N, *self._mass)
+
     def _calc(self, context: Context) -> RobotTerms:
-        self.kinematics.set_mass_scale(float(self._scale.Eval(context)[0]))
+        self.kinematics.set_mass_scale(float(self._next_mass.Eval(context)[2]))
         commands: ContactCommands = self._commands.Eval(context)
         frames = self._frames.get(commands.active)
         if frames is None:
             frames = self._frames[commands.active] = active_frames(self.specs, commands.active)
         pulled = bool(self._hands.Eval(context).any())
         return self.kinematics.calc(self._state.Eval(context), frames, HANDS if pulled else ())
+
+    def _CalcEstimate(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, context.get_discrete_state(self._weighing).GetAtIndex(0))
+
+    def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
+        discrete_state.set_value(self._weighing, self._next_mass.Eval(context))

@@ -165,6 +165,8 @@ class TaskReferences:
     # How far the legs have taken over the end of the rise, 0-1 (state 4).
     stance: float
     next_height_integral: float  # the stance's CoM height integral after this tick, m s
+    # int L_ang dt after this tick (+ T L_ang of this tick's state), N m s^2.
+    next_momentum_integral: np.ndarray
     # The posture state after this tick: [latched flag, first tick's posture (nu),
     # q_ref's next value (nu), first tick's base yaw].
     next_posture: np.ndarray
@@ -367,6 +369,7 @@ class ReferenceGenerator:
             vertical_weight_scale=vertical_weight_scale,
             stance=stance,
             next_height_integral=next_height_integral,
+            next_momentum_integral=momentum_integral + self._period_s * terms.L_WCom[:3],
             next_posture=np.concatenate((self._latched, q_initial, q_next, (base_yaw,))),
         )
 
@@ -375,8 +378,8 @@ class TaskReferenceGenerator(LeafSystem):
     """Each tick's TaskReferences (ReferenceGenerator.calc) as a system, every period_s.
 
     Inputs: terms (abstract RobotTerms, control/model.py), standup_state (1),
-    com_reference (9, payloads.COM_REFERENCE), hand_wrenches_W (12), path_progress (1;
-    unconnected: 1, the segment finished). Outputs: task_references (abstract
+    com_reference (9, payloads.COM_REFERENCE), hand_wrenches_W (12), path_progress (1:
+    how far along its segment the CoM reference is, 0-1). Outputs: task_references (abstract
     TaskReferences) and lean_W (3: the CoM target's lean after the last tick, m).
     Discrete state: the angular momentum's integral (3, N m s^2), the posture state
     (TaskReferences.next_posture), the lean (3, m), the stance's height integral (1, m s).
@@ -413,9 +416,7 @@ class TaskReferenceGenerator(LeafSystem):
     def _calc(self, context: Context) -> TaskReferences:
         state = context.get_discrete_state()
         F_hand_W = self._hands.Eval(context)
-        progress = (
-            float(self._progress.Eval(context)[0]) if self._progress.HasValue(context) else 1.0
-        )
+        progress = float(self._progress.Eval(context)[0])
         standup_state = min(max(int(round(self._state_input.Eval(context)[0])), 1), 4)
         return self._generator.calc(
             self._terms.Eval(context),
@@ -434,9 +435,7 @@ class TaskReferenceGenerator(LeafSystem):
 
     def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
         references = self._references.Eval(context)
-        terms = self._terms.Eval(context)
-        integral = context.get_discrete_state(self._integral).value()
-        discrete_state.set_value(self._integral, integral + self._period_s * terms.L_WCom[:3])
+        discrete_state.set_value(self._integral, references.next_momentum_integral)
         discrete_state.set_value(self._posture, references.next_posture)
         discrete_state.set_value(self._lean, references.lean_W)
         discrete_state.set_value(self._height_integral, [references.next_height_integral])

@@ -29,7 +29,7 @@ from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 from drake_standup.caching import declare_cached
 from drake_standup.config import ControllerConfig
 from drake_standup.phases import PhaseTable
-from drake_standup.state_machine import StandupMode, seat_loads
+from drake_standup.state_machine import StandupMode, seat_loads, seat_releases
 
 # The controller's contacts: the seat pads (state_machine.SEAT_LOADS' order) and soles.
 CONTACTS = ("seat", "l_thigh", "r_thigh", "l_sole", "r_sole")
@@ -99,7 +99,7 @@ class ContactScheduler(LeafSystem):
     """ContactCommands for the whole-body controller, every period_s.
 
     Inputs: mode (abstract StandupMode, the state machine's), seat_pad_normal_forces_N
-    (3: buttocks, left and right thigh pad, measured; unconnected: no measured bound),
+    (3: buttocks, left and right thigh pad, measured),
     commanded_normal_forces_N (5: what the controller's last tick asked of CONTACTS, NaN
     where its QP failed). Output: contact_commands (abstract ContactCommands).
     Discrete state: [the loads the seat pads' release starts from (3), the controller's
@@ -110,6 +110,7 @@ class ContactScheduler(LeafSystem):
         super().__init__()
         self._config = config
         self._table = table
+        self._releases = seat_releases(table)
         self._mode = self.DeclareAbstractInputPort("mode", Value[object](StandupMode()))
         self._measured = self.DeclareVectorInputPort("seat_pad_normal_forces_N", 3)
         self._commanded = self.DeclareVectorInputPort("commanded_normal_forces_N", len(CONTACTS))
@@ -141,9 +142,9 @@ class ContactScheduler(LeafSystem):
         mode = self._mode.Eval(context)
         commanded = self._commanded.Eval(context)[CHAIR]
         last = commanded if np.isfinite(commanded).all() else memory[3:]
-        loads = seat_loads(mode, context.get_time(), self._table)
+        loads = seat_loads(mode, context.get_time(), self._releases)
         unload_from = next_unload_from(memory[:3], last, loads)
-        measured = self._measured.Eval(context) if self._measured.HasValue(context) else None
+        measured = self._measured.Eval(context)
         commands = contact_commands(
             self._config, loads, unload_from, measured, phase_seat_hold(mode, self._table)
         )
