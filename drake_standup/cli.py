@@ -133,12 +133,13 @@ def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> 
         print("error: --no-recording: not with --live (the live page is Meshcat)", file=sys.stderr)
         return 2
 
-    from drake_standup.config import ScenarioError, load_scenario
+    from drake_standup.config import ScenarioError, check_output_dir, load_scenario
 
     try:
         overrides = [parse_set(text) for text in args.overrides]
         duration = [] if args.duration is None else [("duration_s", args.duration)]
         scenario = load_scenario(args.scenario, overrides + duration)
+        check_output_dir(args.out, "--out")
     except ScenarioError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

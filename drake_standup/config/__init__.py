@@ -4,11 +4,13 @@ scenario.py    the typed sections of a scenario (robot, human, advancement, stan
 controller.py  the whole-body controller's gains, weights and limits
 loading.py     a YAML file and overrides into those dataclasses (Drake's yaml_load_typed)
 rules.py       the bounds and accepted values of every field, and the checks across fields
+inputs.py      the files and folders a user names (read_text_file, check_output_dir)
 errors.py      ScenarioError: one line naming the key or file
 """
 
 from drake_standup.config.controller import QP_SOLVERS, ControllerConfig
 from drake_standup.config.errors import ScenarioError
+from drake_standup.config.inputs import check_output_dir, read_text_file
 from drake_standup.config.loading import (
     apply_overrides,
     expand_key_path,
@@ -62,8 +64,10 @@ __all__ = [
     "VisualizationConfig",
     "apply_overrides",
     "chair_file",
+    "check_output_dir",
     "expand_key_path",
     "load_scenario",
     "parse_scenario",
+    "read_text_file",
     "validate",
 ]

@@ -1,0 +1,256 @@
+"""Every user input is checked in one place (drake_standup.config: inputs.py and rules.py)
+before anything simulates.
+
+Each bad input goes through the command line (cli.main in this process, and a subset
+through `python -m drake_standup` in a fresh one): exit code 2, stderr exactly one
+'error:' line naming the key or file, the value and what is accepted, no traceback, nothing
+written. The good inputs next to them still pass, checked against what Drake builds.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import icub_models
+import pytest
+from pydrake.multibody.plant import MultibodyPlant
+
+from drake_standup.cli import main
+from drake_standup.perturbations import robot_body_names
+from drake_standup.robot import Robot, add_icub
+
+REPO = Path(__file__).resolve().parent.parent
+SHIPPED_CHAIR = REPO / "models" / "chair.sdf"
+MODEL = "iCubGazeboV2_5"
+THIGHS = "l_upper_leg_back_contact, r_upper_leg_back_contact"
+# The models of icub-models whose URDF lacks frames the scene needs, and those frames: the
+# thighs' contact frames (the older iCubs), or all but the hand's (the hand models).
+LACKING = {
+    "iCubGenova03": THIGHS,
+    "iCubLisboa01": THIGHS,
+    "iCubNancy01": THIGHS,
+    "left_hand_mk3": f"root_link, l_sole, r_sole, l_hand_dh_frame, r_hand_dh_frame, {THIGHS}",
+    "left_wrist_mk2": f"root_link, l_sole, r_sole, l_hand_dh_frame, r_hand_dh_frame, {THIGHS}",
+}
+FITTING = [name for name in sorted(icub_models.get_robot_names()) if name not in LACKING]
+
+SDF = '<sdf version="1.9">{}</sdf>'
+CHAIR_CONTENT = (
+    "an SDF file of one model with a link or frame named 'chair' (the scene welds it to the "
+    "world), e.g. models/chair.sdf"
+)
+CHAIR_FILES = (
+    "an SDF file path (absolute or relative to the current directory), or models/chair.sdf"
+)
+UTF8 = "a text file saved as UTF-8"
+LATIN1 = "duration_s: 1.0\n# café\n".encode("latin-1")
+
+
+def _shipped(folder: str) -> str:
+    return ", ".join(sorted(p.stem for p in (REPO / folder).glob("*.yaml")))
+
+
+def _revolute_joints(model: str) -> str:
+    """The revolute joints of model's URDF, in its order (read here with xml.etree)."""
+    root = ET.parse(icub_models.get_model_file(model)).getroot()
+    return ", ".join(j.get("name") for j in root.findall("joint") if j.get("type") == "revolute")
+
+
+@pytest.fixture(scope="module")
+def built() -> dict[bool, tuple[MultibodyPlant, Robot]]:
+    """The default model as the scene adds it (visuals on), reduced and not."""
+    plants = {}
+    for reduce in (True, False):
+        plant = MultibodyPlant(0.0)
+        plants[reduce] = plant, add_icub(plant, MODEL, reduce=reduce, visuals=True)
+    return plants
+
+
+# Bad input -> (files to write: name -> text, bytes or None for a folder; the command line;
+# the one error line). In the line, {scenarios}, {sweeps}, {models}, {joints} and {bodies}
+# stand for the shipped scenarios and sweeps, the models with the scene's frames, the
+# default model's joints and its reduced model's bodies.
+RUN = ["run", "--no-recording", "--out", "o"]
+BAD = {
+    # 1. The scenario file (--scenario).
+    "scenario_missing": (
+        {},
+        [*RUN, "--scenario", "missing.yaml"],
+        "scenario: file 'missing.yaml' not found; accepted: a YAML file or a shipped "
+        "scenario: {scenarios}",
+    ),
+    "scenario_folder": (
+        {"adir": None},
+        [*RUN, "--scenario", "adir"],
+        "scenario: 'adir' is a folder; accepted: a YAML file or a shipped scenario: {scenarios}",
+    ),
+    "scenario_utf16": (
+        {"utf16.yaml": b"\xff\xfed\x00u\x00"},
+        [*RUN, "--scenario", "utf16.yaml"],
+        f"scenario: 'utf16.yaml' is not UTF-8 text (byte 0xff on line 1); accepted: {UTF8}",
+    ),
+    "scenario_latin1": (
+        {"latin1.yaml": LATIN1},
+        [*RUN, "--scenario", "latin1.yaml"],
+        f"scenario: 'latin1.yaml' is not UTF-8 text (byte 0xe9 on line 2); accepted: {UTF8}",
+    ),
+    "scenario_unreadable": (
+        {},
+        [*RUN, "--scenario", "/proc/self/mem"],
+        f"scenario: '/proc/self/mem' cannot be read ({os.strerror(errno.EIO)}); accepted: a "
+        "file this user can read",
+    ),
+    "scenario_not_yaml": (
+        {"bad.yaml": "duration_s: [1\n"},
+        [*RUN, "--scenario", "bad.yaml"],
+        'scenario bad.yaml: not valid YAML (while parsing a flow sequence in "<unicode '
+        "string>\", line 1, column 13: duration_s: [1 ^ expected ',' or ']', but got "
+        "'<stream end>' in \"<unicode string>\", line 2, column 1: ^)",
+    ),
+    "scenario_not_a_mapping": (
+        {"list.yaml": "- 1\n- 2\n"},
+        [*RUN, "--scenario", "list.yaml"],
+        "scenario list.yaml: [1, 2]; accepted: a mapping of robot, duration_s, plant, "
+        "simulator, human, advancement, standup, controller, controller_period_s, initial, "
+        "chair, seat_hold, fall, perturbation, visualization, log_period_s",
+    ),
+    # 3. The sweep file (drake-standup sweep PATH) and the base scenario it names.
+    "sweep_missing": (
+        {},
+        ["sweep", "missing.yaml"],
+        "sweep: file 'missing.yaml' not found; accepted: a YAML file or a shipped sweep: {sweeps}",
+    ),
+    "sweep_folder": (
+        {"adir": None},
+        ["sweep", "adir"],
+        "sweep: 'adir' is a folder; accepted: a YAML file or a shipped sweep: {sweeps}",
+    ),
+    "sweep_latin1": (
+        {"latin1.yaml": LATIN1},
+        ["sweep", "latin1.yaml"],
+        f"sweep: 'latin1.yaml' is not UTF-8 text (byte 0xe9 on line 2); accepted: {UTF8}",
+    ),
+    "sweep_not_yaml": (
+        {"bad.yaml": "base: [assisted\n"},
+        ["sweep", "bad.yaml"],
+        'sweep bad.yaml: not valid YAML (while parsing a flow sequence in "<unicode '
+        "string>\", line 1, column 7: base: [assisted ^ expected ',' or ']', but got "
+        "'<stream end>' in \"<unicode string>\", line 2, column 1: ^)",
+    ),
+    "sweep_not_a_mapping": (
+        {"list.yaml": "- assisted\n"},
+        ["sweep", "list.yaml"],
+        "sweep list.yaml: ['assisted']; accepted: a mapping of name, base, seed, samples, "
+        "overrides, grid, random, perturbations, figures",
+    ),
+    "sweep_base_latin1": (
+        {"latin1.yaml": LATIN1, "sweep.yaml": "base: latin1.yaml\n"},
+        ["sweep", "sweep.yaml"],
+        f"base: 'latin1.yaml' is not UTF-8 text (byte 0xe9 on line 2); accepted: {UTF8}",
+    ),
+    # 4. The output folder (--out), refused before anything simulates.
+    "run_out_is_a_file": (
+        {"afile": "x"},
+        ["run", "--no-recording", "--out", "afile"],
+        "--out: 'afile' is a file; accepted: a folder",
+    ),
+    "run_out_under_a_file": (
+        {"afile": "x"},
+        ["run", "--no-recording", "--out", "afile/sub"],
+        "--out: 'afile/sub' lies under a file; accepted: a folder path whose parents are folders",
+    ),
+    "sweep_out_is_a_file": (
+        {"afile": "x"},
+        ["sweep", "assistance", "--out", "afile"],
+        "--out: 'afile' is a file; accepted: a folder",
+    ),
+}
+# One of each kind through `python -m drake_standup` in a fresh process as well.
+IN_A_FRESH_PROCESS = [
+    "scenario_utf16",
+    "sweep_not_yaml",
+    "run_out_under_a_file",
+]
+
+
+def _expected(line: str, cwd: Path, built) -> str:
+    plant, robot = built[True]
+    return "error: " + line.format(
+        scenarios=_shipped("scenarios"),
+        sweeps=_shipped("sweeps"),
+        models=", ".join(FITTING),
+        joints=_revolute_joints(MODEL),
+        bodies=", ".join(robot_body_names(plant, robot)),
+        cwd=cwd,
+    )
+
+
+def _write(cwd: Path, files: dict) -> None:
+    for name, content in files.items():
+        path = cwd / name
+        if content is None:
+            path.mkdir()
+        elif isinstance(content, bytes):
+            path.write_bytes(content)
+        else:
+            path.write_text(content)
+
+
+def _assert_one_error_line(code, stdout: str, stderr: str, expected: str, cwd: Path) -> None:
+    assert "Traceback" not in stderr
+    assert code == 2, stderr
+    assert stderr.splitlines() == [expected]
+    assert stdout == ""
+    assert not list(cwd.rglob("metrics.json")) and not list(cwd.rglob("results.csv"))
+
+
+@pytest.mark.parametrize(("files", "argv", "line"), list(BAD.values()), ids=list(BAD))
+def test_bad_input_is_one_error_line_and_exit_2(
+    tmp_path, monkeypatch, capfd, built, files, argv, line
+):
+    """cli.main on each bad input, run from a folder holding its files: exit code 2 and
+    the one error line, on the process's stderr (capfd: Drake's own output included)."""
+    _write(tmp_path, files)
+    monkeypatch.chdir(tmp_path)
+    try:
+        code = main(argv)
+    except SystemExit as stop:
+        code = stop.code
+    stdout, stderr = capfd.readouterr()
+    _assert_one_error_line(code, stdout, stderr, _expected(line, tmp_path, built), tmp_path)
+
+
+@pytest.mark.parametrize("name", IN_A_FRESH_PROCESS)
+def test_bad_input_through_python_m_drake_standup(tmp_path, built, name):
+    """The same bad inputs through the real command, in a fresh process."""
+    files, argv, line = BAD[name]
+    _write(tmp_path, files)
+    env = {**os.environ, "PYTHONPATH": str(REPO)}  # this checkout's package
+    done = subprocess.run(
+        [sys.executable, "-m", "drake_standup", *argv],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    expected = _expected(line, tmp_path, built)
+    _assert_one_error_line(done.returncode, done.stdout, done.stderr, expected, tmp_path)
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root reads a file whatever its mode")
+def test_a_scenario_without_read_permission(tmp_path, capfd):
+    path = tmp_path / "secret.yaml"
+    path.write_text("duration_s: 1.0\n")
+    path.chmod(0)
+    assert main([*RUN, "--scenario", str(path)]) == 2
+    assert capfd.readouterr().err.splitlines() == [
+        f"error: scenario: '{path}' cannot be read (Permission denied); accepted: a file this "
+        "user can read"
+    ]
