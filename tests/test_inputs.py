@@ -169,12 +169,26 @@ BAD = {
         ["sweep", "assistance", "--out", "afile"],
         "--out: 'afile' is a file; accepted: a folder",
     ),
+    # 5. A plant this controller cannot run.
+    "continuous_plant": (
+        {},
+        [*RUN, "--set", "plant.time_step=0"],
+        "plant.time_step: 0.0; accepted: a discrete plant's step, a number > 0 s (0, a "
+        "continuous plant, cannot run the controller: it acts at the plant's steps)",
+    ),
+    "continuous_plant_in_a_file": (
+        {"continuous.yaml": "plant:\n  time_step: 0.0\ncontroller_period_s: 0.01\n"},
+        [*RUN, "--scenario", "continuous.yaml"],
+        "plant.time_step: 0.0; accepted: a discrete plant's step, a number > 0 s (0, a "
+        "continuous plant, cannot run the controller: it acts at the plant's steps)",
+    ),
 }
 # One of each kind through `python -m drake_standup` in a fresh process as well.
 IN_A_FRESH_PROCESS = [
     "scenario_utf16",
     "sweep_not_yaml",
     "run_out_under_a_file",
+    "continuous_plant",
 ]
 
 

@@ -27,12 +27,15 @@ class Range:
     high: float = math.inf
     low_open: bool = False
     high_open: bool = False
+    text: str = ""  # what an error says is accepted, if more than the bounds
 
     def accepts(self, x) -> bool:
         above = x > self.low if self.low_open else x >= self.low
         return above and (x < self.high if self.high_open else x <= self.high)
 
     def __str__(self) -> str:
+        if self.text:
+            return self.text
         if self.high == math.inf:
             return f"a number {'>' if self.low_open else '>='} {self.low:g}"
         left, right = "(["[not self.low_open], ")]"[not self.high_open]
@@ -41,6 +44,13 @@ class Range:
 
 INTERVAL = "interval"  # two numbers [low, high] with low < high
 POSITIVE, NON_NEGATIVE, FRACTION = Range(low_open=True), Range(), Range(high=1.0)
+# The controller acts at the plant's steps (controller_period_s is a whole multiple of
+# plant.time_step), and the integrator's steps and the convergence study follow them.
+PLANT_STEP = Range(
+    low_open=True,
+    text="a discrete plant's step, a number > 0 s (0, a continuous plant, cannot run the "
+    "controller: it acts at the plant's steps)",
+)
 
 # What the values at some key paths accept: a Range (of each entry of a list too), a length
 # n (a list of n entries), INTERVAL or a tuple of accepted strings. The key paths are
@@ -74,7 +84,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     ),
     (
         NON_NEGATIVE,
-        "plant.time_step human.pulls[*].start_s human.pulls[*].ramp_s "
+        "human.pulls[*].start_s human.pulls[*].ramp_s "
         "human.reactive.start_s human.reactive.ramp_s human.reactive.stiffness_N_per_m "
         "human.reactive.damping_Ns_per_m human.reactive.travel_m "
         "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
@@ -88,6 +98,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "perturbation.noise_seed plant.sap_near_rigid_threshold simulator.target_realtime_rate "
         "simulator.start_time fall.min_root_height_m",
     ),
+    (PLANT_STEP, "plant.time_step"),
     (Range(low=1.0), "advancement.psi_dot_upper"),
     (Range(high=1.0, high_open=True), "advancement.taper_from_progress"),
     (Range(high=1.0, high_open=True), "controller.stance_from_progress"),
@@ -172,11 +183,11 @@ def validate(scenario: Scenario) -> Scenario:
             f"robot.model: unknown model '{scenario.robot.model}'; "
             f"accepted: {', '.join(sorted(icub_models.get_robot_names()))}"
         )
-    # The controller's period is a whole multiple of a discrete plant's step: the plant
-    # reads its actuation input only at its own steps, so a faster controller is wasted
-    # work and a period off the plant's grid jitters.
+    # The controller's period is a whole multiple of the plant's step: the plant reads its
+    # actuation input only at its own steps, so a faster controller is wasted work and a
+    # period off the plant's grid jitters.
     step, period = scenario.plant.time_step, scenario.controller_period_s
-    ratio = period / step if step > 0 else 1.0  # a continuous plant: any period
+    ratio = period / step
     if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
         raise ScenarioError(
             f"controller_period_s: {period}; accepted: a whole multiple of plant.time_step "
