@@ -21,6 +21,14 @@ import pytest
 from pydrake.multibody.plant import MultibodyPlant
 
 from drake_standup.cli import main
+from drake_standup.config import (
+    ChairConfig,
+    Scenario,
+    ScenarioError,
+    apply_overrides,
+    validate,
+)
+from drake_standup.config.inputs import check_chair_file
 from drake_standup.perturbations import robot_body_names
 from drake_standup.robot import Robot, add_icub
 
@@ -119,6 +127,84 @@ BAD = {
         "simulator, human, advancement, standup, controller, controller_period_s, initial, "
         "chair, seat_hold, fall, perturbation, visualization, log_period_s",
     ),
+    # 2. The chair file (chair.file).
+    "chair_missing": (
+        {},
+        [*RUN, "--set", "chair.file=nope.sdf"],
+        f"chair.file: file 'nope.sdf' not found; accepted: {CHAIR_FILES}",
+    ),
+    "chair_folder": (
+        {"adir": None},
+        [*RUN, "--set", "chair.file=adir"],
+        f"chair.file: 'adir' is a folder; accepted: {CHAIR_FILES}",
+    ),
+    "chair_latin1": (
+        {"chair.sdf": "<!-- café -->".encode("latin-1")},
+        [*RUN, "--set", "chair.file=chair.sdf"],
+        f"chair.file: 'chair.sdf' is not UTF-8 text (byte 0xe9 on line 1); accepted: {UTF8}",
+    ),
+    "chair_plain_text": (
+        {"chair.txt": "a chair\n"},
+        [*RUN, "--set", "chair.file=chair.txt"],
+        f"chair.file: 'chair.txt' is not XML (syntax error: line 1, column 0); accepted: "
+        f"{CHAIR_CONTENT}",
+    ),
+    "chair_xml_not_sdf": (
+        {"robot.sdf": '<robot name="chair"><link name="chair"/></robot>'},
+        [*RUN, "--set", "chair.file=robot.sdf"],
+        f"chair.file: 'robot.sdf' is not SDF (its root element is <robot>, not <sdf>); "
+        f"accepted: {CHAIR_CONTENT}",
+    ),
+    "chair_fails_drake": (
+        {"broken.sdf": SDF.format('<model name="x"><link name="chair"><foo/></link></model>')},
+        [*RUN, "--set", "chair.file=broken.sdf"],
+        "chair.file: 'broken.sdf' fails Drake's SDF parser (<data-string>:1: error: At XML "
+        'path /sdf/model[@name="x"]/link[@name="chair"]/foo: XML Element[foo], child of '
+        "element[link], not defined in SDF. Copying[foo] as children of [link].); accepted: "
+        f"{CHAIR_CONTENT}",
+    ),
+    "chair_missing_mesh": (
+        {
+            "mesh.sdf": SDF.format(
+                '<model name="x"><link name="chair"><visual name="v"><geometry><mesh>'
+                "<uri>nope.obj</uri></mesh></geometry></visual></link></model>"
+            )
+        },
+        [*RUN, "--set", "chair.file=mesh.sdf"],
+        "chair.file: 'mesh.sdf' fails Drake's SDF parser (/{cwd}/mesh.sdf:1: error: URI "
+        f"'nope.obj' resolved to '{{cwd}}/nope.obj' which does not exist.); accepted: "
+        f"{CHAIR_CONTENT}",
+    ),
+    "chair_no_chair_frame": (
+        {"stool.sdf": SDF.format('<model name="stool"><link name="seat"/></model>')},
+        [*RUN, "--set", "chair.file=stool.sdf"],
+        "chair.file: 'stool.sdf' has no frame named 'chair' (model 'stool' has: seat, "
+        f"__model__); accepted: {CHAIR_CONTENT}",
+    ),
+    "chair_two_models": (
+        {
+            "two.sdf": SDF.format(
+                '<world name="w"><model name="a"><link name="chair"/></model>'
+                '<model name="b"><link name="chair"/></model></world>'
+            )
+        },
+        [*RUN, "--set", "chair.file=two.sdf"],
+        f"chair.file: 'two.sdf' holds 2 models (a, b); accepted: {CHAIR_CONTENT}",
+    ),
+    "chair_welded_already": (
+        {
+            "welded.sdf": SDF.format(
+                '<model name="x"><link name="chair"/><joint name="j" type="fixed">'
+                "<parent>world</parent><child>chair</child></joint></model>"
+            )
+        },
+        [*RUN, "--set", "chair.file=welded.sdf"],
+        "chair.file: 'welded.sdf' cannot be welded to the world at its frame 'chair' "
+        "(AddJoint(): This LinkJointGraph already has joint 'j' (model instance 2) connecting "
+        "link 'world' to link 'chair'. Therefore adding joint 'world_welds_to_chair' (model "
+        "instance 2) connecting link 'world' to link 'chair' is not allowed.); accepted: "
+        f"{CHAIR_CONTENT}",
+    ),
     # 3. The sweep file (drake-standup sweep PATH) and the base scenario it names.
     "sweep_missing": (
         {},
@@ -186,6 +272,8 @@ BAD = {
 # One of each kind through `python -m drake_standup` in a fresh process as well.
 IN_A_FRESH_PROCESS = [
     "scenario_utf16",
+    "chair_xml_not_sdf",
+    "chair_fails_drake",
     "sweep_not_yaml",
     "run_out_under_a_file",
     "continuous_plant",
@@ -268,3 +356,41 @@ def test_a_scenario_without_read_permission(tmp_path, capfd):
         f"error: scenario: '{path}' cannot be read (Permission denied); accepted: a file this "
         "user can read"
     ]
+
+
+# --- The good inputs next to the bad ones -----------------------------------------------
+
+
+def test_the_shipped_chair_and_a_copy_of_it_pass(tmp_path, monkeypatch):
+    """models/chair.sdf by its default name, a copy by its absolute path and by a path
+    relative to the current folder: each validates, and names the file the scene loads."""
+    assert check_chair_file(Scenario().chair.file).resolve() == SHIPPED_CHAIR
+    copy = tmp_path / "my_chair.sdf"
+    copy.write_text(SHIPPED_CHAIR.read_text())
+    scenario = apply_overrides(Scenario(), [("chair.file", str(copy))])
+    assert check_chair_file(scenario.chair.file) == copy
+    monkeypatch.chdir(tmp_path)
+    scenario = validate(Scenario(chair=ChairConfig(file="my_chair.sdf")))
+    assert check_chair_file(scenario.chair.file) == Path("my_chair.sdf")
+
+
+def test_a_chair_frame_and_drake_warnings_pass_quietly(tmp_path, caplog):
+    """A 'chair' that is a frame (not a link) passes, and what Drake warns about while the
+    check parses the file is not logged (the scene's build warns once)."""
+    path = tmp_path / "frame.sdf"
+    model = '<link name="seat"><velocity_decay/></link><frame name="chair" attached_to="seat"/>'
+    path.write_text(SDF.format(f'<model name="stool">{model}</model>'))
+    with caplog.at_level("DEBUG", logger="drake"):
+        assert check_chair_file(str(path)) == path
+    assert [r.getMessage() for r in caplog.records if r.name == "drake"] == []
+
+
+def test_a_changed_chair_file_is_checked_again(tmp_path):
+    """The check is cached per file version: the same path, rewritten, is parsed again."""
+    path = tmp_path / "chair.sdf"
+    path.write_text(SHIPPED_CHAIR.read_text())
+    check_chair_file(str(path))
+    path.write_text(SDF.format('<model name="x"><link name="stool"/></model>'))
+    os.utime(path, ns=(path.stat().st_atime_ns, path.stat().st_mtime_ns + 10**9))
+    with pytest.raises(ScenarioError, match="has no frame named 'chair'"):
+        check_chair_file(str(path))

@@ -16,7 +16,8 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 
 from drake_standup.config.controller import QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
-from drake_standup.config.scenario import Scenario, chair_file
+from drake_standup.config.inputs import check_chair_file
+from drake_standup.config.scenario import Scenario
 
 
 @dataclass(frozen=True)
@@ -193,11 +194,7 @@ def validate(scenario: Scenario) -> Scenario:
             f"controller_period_s: {period}; accepted: a whole multiple of plant.time_step "
             f"({step}), e.g. {step} or {2 * step}"
         )
-    if not chair_file(scenario.chair.file).is_file():
-        raise ScenarioError(
-            f"chair.file: '{scenario.chair.file}' not found; accepted: an SDF file path "
-            "(absolute or relative to the current directory), or models/chair.sdf"
-        )
+    check_chair_file(scenario.chair.file)
     for i, pull in enumerate(scenario.human.pulls):
         if 2 * pull.ramp_s > pull.duration_s:
             raise ScenarioError(
