@@ -135,6 +135,7 @@ def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> 
 
     from drake_standup.config import ScenarioError, check_output_dir, load_scenario
 
+    # Every input checked here, before anything is built or simulated (config.validate).
     try:
         overrides = [parse_set(text) for text in args.overrides]
         duration = [] if args.duration is None else [("duration_s", args.duration)]
@@ -146,16 +147,12 @@ def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> 
 
     from drake_standup.simulate import simulate
 
-    try:
-        if args.live:
-            from drake_standup.live import run_live
+    if args.live:
+        from drake_standup.live import run_live
 
-            result = run_live(scenario, args.out, args.duration)
-        else:
-            result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
-    except ScenarioError as err:  # what only the built model can check (e.g. a body's name)
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+        result = run_live(scenario, args.out, args.duration)
+    else:
+        result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
     m = result.metrics
     for name, path in result.files.items():
         print(f"wrote {name}: {path}")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -18,19 +19,25 @@ from pathlib import Path
 
 import icub_models
 import pytest
+import yaml
+from pydrake.common.yaml import yaml_dump_typed
 from pydrake.multibody.plant import MultibodyPlant
 
 from drake_standup.cli import main
 from drake_standup.config import (
+    JOINT_TABLES,
     ChairConfig,
+    PerturbationConfig,
+    Push,
+    RobotConfig,
     Scenario,
     ScenarioError,
     apply_overrides,
     validate,
 )
-from drake_standup.config.inputs import check_chair_file
+from drake_standup.config.inputs import check_chair_file, model_names, scene_frames
 from drake_standup.perturbations import robot_body_names
-from drake_standup.robot import Robot, add_icub
+from drake_standup.robot import ContactModel, Robot, add_icub
 
 REPO = Path(__file__).resolve().parent.parent
 SHIPPED_CHAIR = REPO / "models" / "chair.sdf"
@@ -268,6 +275,62 @@ BAD = {
         "plant.time_step: 0.0; accepted: a discrete plant's step, a number > 0 s (0, a "
         "continuous plant, cannot run the controller: it acts at the plant's steps)",
     ),
+    # 6. Robot models whose URDF lacks frames the scene needs.
+    **{
+        f"model_{name}": (
+            {},
+            [*RUN, "--set", f"robot.model={name}"],
+            f"robot.model: '{name}' lacks the frames the scene needs: {missing}; "
+            "accepted: {models}",
+        )
+        for name, missing in LACKING.items()
+    },
+    # 7. Joint and body names the model does not have.
+    "unknown_initial_joint": (
+        {},
+        [*RUN, "--set", "initial.joints_rad={l_knee: -1.7, l_kne: -1.7}"],
+        "initial.joints_rad: unknown joint(s) l_kne; accepted: the joints of iCubGazeboV2_5: "
+        "{joints}",
+    ),
+    "unknown_posture_joint": (
+        {"posture.yaml": "controller:\n  posture_state3_rad: {l_elbow: 0.3, elbow: 0.3}\n"},
+        [*RUN, "--scenario", "posture.yaml"],
+        "controller.posture_state3_rad: unknown joint(s) elbow; accepted: the joints of "
+        "iCubGazeboV2_5: {joints}",
+    ),
+    "unknown_arm_weight_joint": (
+        {},
+        [*RUN, "--set", "controller.stance_arm_weight_by_joint={l_wrist: 7.0}"],
+        "controller.stance_arm_weight_by_joint: unknown joint(s) l_wrist; accepted: the joints "
+        "of iCubGazeboV2_5: {joints}",
+    ),
+    "unknown_seat_hinge_joint": (
+        {},
+        [*RUN, "--set", "controller.seat_hinge_joints=[l_hip, r_hip_pitch]"],
+        "controller.seat_hinge_joints: unknown joint(s) l_hip; accepted: the joints of "
+        "iCubGazeboV2_5: {joints}",
+    ),
+    "unknown_push_body": (
+        {},
+        [*RUN, "--set", "perturbation.pushes=[{body: torso}]"],
+        "perturbation.pushes[0].body: 'torso' unknown; accepted: the bodies of iCubGazeboV2_5 "
+        "reduced: {bodies}",
+    ),
+    "push_on_a_frame_of_the_reduced_model": (
+        {},
+        [*RUN, "--set", "perturbation.pushes=[{body: chest}, {body: l_hand_dh_frame}]"],
+        "perturbation.pushes[1].body: 'l_hand_dh_frame' is a frame of the reduced model "
+        "(robot.reduced: true), not a body; accepted: the bodies of iCubGazeboV2_5 reduced: "
+        "{bodies}",
+    ),
+    "sweep_push_on_an_unknown_body": (
+        {"pushes.yaml": "base: assisted\nperturbations:\n  push: {body: spine, magnitude_N: 10}\n"},
+        ["sweep", "pushes.yaml"],
+        "run 0 ({{'push_start_s': 5.0, 'push_duration_s': 0.2, 'push_magnitude_N': 10, "
+        "'push_impulse_Ns': 2.0, 'push_azimuth_deg': 0.0, 'push_elevation_deg': 0.0}}): "
+        "perturbation.pushes[0].body: 'spine' unknown; accepted: the bodies of "
+        "iCubGazeboV2_5 reduced: {bodies}",
+    ),
 }
 # One of each kind through `python -m drake_standup` in a fresh process as well.
 IN_A_FRESH_PROCESS = [
@@ -277,6 +340,8 @@ IN_A_FRESH_PROCESS = [
     "sweep_not_yaml",
     "run_out_under_a_file",
     "continuous_plant",
+    "model_iCubGenova03",
+    "unknown_seat_hinge_joint",
 ]
 
 
@@ -394,3 +459,113 @@ def test_a_changed_chair_file_is_checked_again(tmp_path):
     os.utime(path, ns=(path.stat().st_atime_ns, path.stat().st_mtime_ns + 10**9))
     with pytest.raises(ScenarioError, match="has no frame named 'chair'"):
         check_chair_file(str(path))
+
+
+@pytest.mark.parametrize("model", sorted(icub_models.get_robot_names()))
+def test_a_model_validates_exactly_when_the_scene_can_be_built_on_it(model):
+    """validate vs Drake: for every model of icub-models, validate passes if and only if
+    add_icub (with the contact model's frames) builds it and every task frame, every
+    default joint table's joint and the default push body resolve in the plant."""
+    scenario = Scenario(
+        robot=RobotConfig(model=model), perturbation=PerturbationConfig(pushes=[Push("chest")])
+    )
+    try:
+        validate(scenario)
+        valid = True
+    except ScenarioError as err:
+        assert str(err).startswith(f"robot.model: '{model}' lacks the frames the scene needs")
+        valid = False
+    try:
+        plant = MultibodyPlant(0.0)
+        robot = add_icub(plant, model, visuals=False)
+        plant.Finalize()
+        for task in Robot.TASK_FRAMES:
+            robot.frame(plant, task)
+        for _, table in _joint_tables(scenario):
+            for name in table:
+                plant.GetJointByName(name, robot.model_instance)
+        plant.GetBodyByName("chest", robot.model_instance)
+        builds = True
+    except RuntimeError:
+        builds = False
+    assert valid == builds
+    assert valid == (model in FITTING)
+
+
+@pytest.mark.parametrize("reduce", [True, False], ids=["reduced", "full"])
+def test_the_bodies_validate_accepts_are_the_built_plants(built, reduce):
+    """model_names' bodies (read from the URDF's XML) vs the bodies of the robot Drake
+    builds with robot.reduced: the same names in the same order."""
+    plant, robot = built[reduce]
+    assert list(model_names(MODEL).bodies(reduce)) == robot_body_names(plant, robot)
+    assert set(model_names(MODEL).joints) == set(robot.joint_names)
+
+
+def test_the_reduction_rule_on_a_model_with_massless_moving_links():
+    """iCubGenova03 has massless links on revolute joints and massless links with visuals,
+    which the default model has not (both stay bodies): model_names' reduced bodies vs
+    Drake's plant of it (built without the contact frames it lacks)."""
+    plant = MultibodyPlant(0.0)
+    robot = add_icub(plant, "iCubGenova03", reduce=True, visuals=True, contact=ContactModel())
+    bodies = robot_body_names(plant, robot)
+    assert {"l_wrist_1", "torso_2", "neck_1"} <= set(bodies)
+    assert list(model_names("iCubGenova03").bodies(True)) == bodies
+
+
+def test_the_scene_frames_are_frames_of_the_built_plant(built):
+    """scene_frames() vs the default model Drake builds: each one a frame of the robot,
+    and every task frame either one of them or a frame the contact file adds on them."""
+    plant, robot = built[True]
+    for name in scene_frames():
+        assert plant.HasFrameNamed(name, robot.model_instance), name
+    assert set(Robot.TASK_FRAMES.values()) <= set(scene_frames()) | {
+        "l_upper_leg_contact",
+        "r_upper_leg_contact",
+        "buttocks_contact",
+        "seat_contact",
+    }
+
+
+def test_known_names_and_a_body_of_the_full_model_pass():
+    """Joint tables with the model's own joints, and a push on a link that is a body of the
+    full model (robot.reduced: false) though a frame of the reduced one, validate."""
+    scenario = apply_overrides(
+        Scenario(),
+        [
+            ("robot.reduced", False),
+            ("controller.posture_weight_by_joint", {"l_knee": 2.0, "torso_yaw": 1.0}),
+            ("controller.seat_hinge_joints", ["l_hip_roll", "r_hip_roll"]),
+            ("perturbation.pushes", [{"body": "l_hand_dh_frame"}]),
+        ],
+    )
+    assert scenario.perturbation.pushes[0].body == "l_hand_dh_frame"
+    assert scenario.controller.seat_hinge_joints == ["l_hip_roll", "r_hip_roll"]
+
+
+def _joint_tables(scenario: Scenario) -> list[tuple[str, object]]:
+    """(key path, value) of every key of scenario that a JOINT_TABLES pattern names."""
+    found = []
+
+    def walk(key: str, value) -> None:
+        if any(re.fullmatch(regex, key) for regex in patterns):
+            found.append((key, value))
+        items = value.items() if isinstance(value, dict) else ()
+        items = enumerate(value) if isinstance(value, list) else items
+        for step, item in items:
+            walk(f"{key}[{step}]" if isinstance(step, int) else f"{key}.{step}", item)
+
+    patterns = [
+        re.escape(p).replace(r"\[\*\]", r"\[\d+\]").replace(r"\*", r"[^.\[]*") for p in JOINT_TABLES
+    ]
+    for key, value in yaml.safe_load(yaml_dump_typed(scenario)).items():
+        walk(key, value)
+    return found
+
+
+def test_every_joint_table_names_a_key():
+    """Each JOINT_TABLES pattern vs the key paths of the default scenario: a pattern that
+    names nothing (a typo, a renamed field) checks nothing; each names joints (a mapping
+    or a list of names)."""
+    tables = _joint_tables(Scenario())
+    assert len(tables) == len(JOINT_TABLES)
+    assert all(isinstance(table, dict | list) and table for _, table in tables)

@@ -2,9 +2,9 @@
 simulates.
 
 Every failure is a ScenarioError: one line naming the option or key, the value, and what
-it accepts. rules.validate calls the checks of a scenario's own keys (chair.file); the
-entry points those of their options (--scenario and a sweep file through read_text_file,
---out through check_output_dir).
+it accepts. rules.validate calls the checks of a scenario's own keys (chair.file, the
+robot model's frames, joints and bodies); the entry points those of their options
+(--scenario and a sweep file through read_text_file, --out through check_output_dir).
 """
 
 import contextlib
@@ -12,8 +12,11 @@ import functools
 import logging
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
+import icub_models
+import yaml
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import ModelInstanceIndex
@@ -21,6 +24,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.scenario import chair_file
+from drake_standup.resources import model_file
 
 # --- Files and folders -------------------------------------------------------------------
 
@@ -161,3 +165,109 @@ def _drop(record: logging.LogRecord) -> bool:
 def _one_line(err: Exception, limit: int = 300) -> str:
     text = " ".join(str(err).split())
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+# --- The robot model: the names the scene needs, and the names its URDF gives -------------
+
+# Task frame -> model frame: the controller speaks of hands and soles (robot.Robot).
+TASK_FRAMES = {
+    "l_sole": "l_sole",
+    "r_sole": "r_sole",
+    "l_hand": "l_hand_dh_frame",
+    "r_hand": "r_hand_dh_frame",
+    "l_thigh": "l_upper_leg_contact",
+    "r_thigh": "r_upper_leg_contact",
+    "buttocks": "buttocks_contact",
+    "seat": "seat_contact",
+}
+# The floating base: scene.set_seated_state poses it, control/terms.py starts the tree there.
+BASE_LINK = "root_link"
+CONTACT_FILE = model_file("icub_contact.yaml")
+
+
+@functools.cache
+def scene_frames() -> tuple[str, ...]:
+    """The frames the scene needs of a robot model's URDF: the floating base, the task
+    frames (TASK_FRAMES), and the frames models/icub_contact.yaml poses its pads and its own
+    frames in; the frames that file adds are not the URDF's to have. (The joints and bodies
+    a scenario names are checked at their keys: rules.JOINT_TABLES and
+    perturbation.pushes[*].body.)"""
+    contact = yaml.safe_load(CONTACT_FILE.read_text())
+    added = {frame["name"] for frame in contact["frames"]}
+    needed = [BASE_LINK, *TASK_FRAMES.values()]
+    needed += [frame["parent"] for frame in contact["frames"]]
+    needed += [shape["frame"] for shape in contact["shapes"]]
+    return tuple(dict.fromkeys(name for name in needed if name not in added))
+
+
+@dataclass(frozen=True)
+class ModelNames:
+    """The names a robot model's URDF gives the plant (robot.add_icub), in URDF order."""
+
+    links: tuple[str, ...]  # every one a frame of the plant, reduced or not
+    joints: tuple[str, ...]  # revolute ones: the actuated joints
+    reduced_bodies: tuple[str, ...]  # the links that stay bodies with robot.reduced
+
+    def bodies(self, reduced: bool) -> tuple[str, ...]:
+        return self.reduced_bodies if reduced else self.links
+
+
+def robot_names() -> list[str]:
+    """Names accepted for robot.model: every model icub-models ships."""
+    return sorted(icub_models.get_robot_names())
+
+
+@functools.cache
+def model_names(model: str) -> ModelNames:
+    """The names of model's URDF as icub-models installs it (robot.original_urdf), read as
+    XML: no plant is built. Cached per model: a sweep validates every run."""
+    root = ET.parse(icub_models.get_model_file(model)).getroot()
+    links = {link.get("name"): link for link in root.findall("link")}
+    joints = root.findall("joint")
+    parent_joint = {joint.find("child").get("link"): joint for joint in joints}
+    children: dict[str, list[str]] = {name: [] for name in links}
+    for joint in joints:
+        children[joint.find("parent").get("link")].append(joint.find("child").get("link"))
+
+    # robot._remove_bare_subtrees' rule (tests/test_inputs.py checks it on a built plant):
+    # a link without mass or visual on a fixed joint, all its children alike, is a frame.
+    @functools.cache
+    def becomes_frame(name: str) -> bool:
+        joint, link = parent_joint.get(name), links[name]
+        mass = link.find("inertial/mass")
+        bare = link.find("visual") is None and (mass is None or float(mass.get("value", "0")) == 0)
+        return (
+            joint is not None
+            and joint.get("type") == "fixed"
+            and bare
+            and all(becomes_frame(child) for child in children[name])
+        )
+
+    return ModelNames(
+        links=tuple(links),
+        joints=tuple(j.get("name") for j in joints if j.get("type") in ("revolute", "continuous")),
+        reduced_bodies=tuple(name for name in links if not becomes_frame(name)),
+    )
+
+
+def missing_scene_frames(model: str) -> list[str]:
+    """The frames of scene_frames() that model's URDF lacks."""
+    links = set(model_names(model).links)
+    return [name for name in scene_frames() if name not in links]
+
+
+def check_robot_model(model: str) -> ModelNames:
+    """robot.model's names, checked: a model of icub-models whose URDF has every frame the
+    scene needs (scene_frames)."""
+    if model not in robot_names():
+        raise ScenarioError(
+            f"robot.model: unknown model '{model}'; accepted: {', '.join(robot_names())}"
+        )
+    missing = missing_scene_frames(model)
+    if missing:
+        fit = [name for name in robot_names() if not missing_scene_frames(name)]
+        raise ScenarioError(
+            f"robot.model: '{model}' lacks the frames the scene needs: {', '.join(missing)}; "
+            f"accepted: {', '.join(fit)}"
+        )
+    return model_names(model)

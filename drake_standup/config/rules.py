@@ -1,7 +1,9 @@
-"""Bounds and accepted values of every field (RULES), and the checks across fields.
+"""Bounds and accepted values of every field (RULES), the keys that name joints of the
+robot model (JOINT_TABLES), and the checks across fields.
 
-validate(scenario) is what the types alone cannot say; every message is one line naming
-the key path and what it accepts.
+validate(scenario) is the one check of a scenario, of what the types alone cannot say:
+RULES, the checks across fields, the robot model's names and the chair file
+(config/inputs.py); every message is one line naming the key path and what it accepts.
 """
 
 import math
@@ -9,14 +11,13 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-import icub_models
 import yaml
 from pydrake.common.yaml import yaml_dump_typed
 from pydrake.systems.analysis import GetIntegrationSchemes
 
 from drake_standup.config.controller import QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
-from drake_standup.config.inputs import check_chair_file
+from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
 from drake_standup.config.scenario import Scenario
 
 
@@ -131,6 +132,21 @@ def _pattern(rule: str) -> re.Pattern:
 
 _COMPILED = [(_pattern(rule), accepted) for accepted, rules in RULES for rule in rules.split()]
 
+# Key paths (patterns as in RULES) whose mapping keys, or list entries, name joints of
+# robot.model: checked against the joints of its URDF, so that no unknown name reaches
+# the plant.
+JOINT_TABLES = (
+    "initial.joints_rad",
+    "controller.posture_weight_by_joint",
+    "controller.stance_posture_weight_by_joint",
+    "controller.stance_arm_weight_by_joint",
+    "controller.posture_state2_rad",
+    "controller.posture_state3_rad",
+    "controller.posture_state4_rad",
+    "controller.seat_hinge_joints",
+)
+_JOINT_TABLES = [_pattern(table) for table in JOINT_TABLES]
+
 
 def _nodes(data, steps: tuple = (), leaves: bool = False) -> Iterator[tuple[list, object]]:
     """(key path steps, value) of every node of plain data (leaves: of every leaf only;
@@ -171,19 +187,56 @@ def _check(key: str, value, accepted) -> None:
 
 
 def validate(scenario: Scenario) -> Scenario:
-    """Checks what the types alone cannot; raises ScenarioError (one line). Returns
-    scenario."""
-    for steps, value in _nodes(yaml.safe_load(yaml_dump_typed(scenario))):
+    """The one check of a scenario before anything simulates: RULES, the checks across
+    fields, the robot model's names (its frames, and every joint and body the scenario
+    names) and the chair file. Raises ScenarioError (one line); returns scenario."""
+    data = yaml.safe_load(yaml_dump_typed(scenario))
+    _check_rules(data)
+    _check_across_fields(scenario)
+    _check_names(scenario, data, check_robot_model(scenario.robot.model))
+    check_chair_file(scenario.chair.file)
+    return scenario
+
+
+def _check_rules(data: dict) -> None:
+    """Every value of data (the scenario as plain YAML data) against RULES."""
+    for steps, value in _nodes(data):
         key = _format(steps)
         _check(key, value, None)
         for pattern, accepted in _COMPILED:
             if pattern.fullmatch(key):
                 _check(key, value, accepted)
-    if scenario.robot.model not in sorted(icub_models.get_robot_names()):
+
+
+def _check_names(scenario: Scenario, data: dict, names: ModelNames) -> None:
+    """The joints of JOINT_TABLES and the pushed bodies vs the robot model's."""
+    model = scenario.robot.model
+    for steps, table in _nodes(data):
+        key = _format(steps)
+        if any(pattern.fullmatch(key) for pattern in _JOINT_TABLES):
+            unknown = sorted(set(table) - set(names.joints))
+            if unknown:
+                raise ScenarioError(
+                    f"{key}: unknown joint(s) {', '.join(unknown)}; accepted: the joints of "
+                    f"{model}: {', '.join(names.joints)}"
+                )
+    reduced = scenario.robot.reduced
+    bodies = names.bodies(reduced)
+    for i, push in enumerate(scenario.perturbation.pushes):
+        if push.body in bodies:
+            continue
+        what = "unknown"
+        if push.body in names.links:  # a massless link of the reduced model
+            what = "is a frame of the reduced model (robot.reduced: true), not a body"
         raise ScenarioError(
-            f"robot.model: unknown model '{scenario.robot.model}'; "
-            f"accepted: {', '.join(sorted(icub_models.get_robot_names()))}"
+            f"perturbation.pushes[{i}].body: '{push.body}' {what}; accepted: the bodies of "
+            f"{model}{' reduced' if reduced else ''}: {', '.join(bodies)}"
         )
+
+
+def _check_across_fields(scenario: Scenario) -> None:
+    """What one value says of another: the controller's period on the plant's step grid,
+    the pulls' ramps, the reactive helper's path and leads."""
     # The controller's period is a whole multiple of the plant's step: the plant reads its
     # actuation input only at its own steps, so a faster controller is wasted work and a
     # period off the plant's grid jitters.
@@ -194,7 +247,6 @@ def validate(scenario: Scenario) -> Scenario:
             f"controller_period_s: {period}; accepted: a whole multiple of plant.time_step "
             f"({step}), e.g. {step} or {2 * step}"
         )
-    check_chair_file(scenario.chair.file)
     for i, pull in enumerate(scenario.human.pulls):
         if 2 * pull.ramp_s > pull.duration_s:
             raise ScenarioError(
@@ -219,4 +271,3 @@ def validate(scenario: Scenario) -> Scenario:
             f"human.reactive.lead_max_m: {reactive.lead_max_m}; accepted: a number >= "
             f"lead_min_m ({reactive.lead_min_m})"
         )
-    return scenario
