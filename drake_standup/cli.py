@@ -110,28 +110,26 @@ def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> 
         print("error: --no-recording: not with --live (the live page is Meshcat)", file=sys.stderr)
         return 2
 
-    from drake_standup.config import ScenarioError, load_scenario
+    from drake_standup.config import ScenarioError, check_output_dir, load_scenario
 
+    # Every input checked here, before anything is built or simulated (config.validate).
     try:
         overrides = [parse_set(text) for text in args.overrides]
         duration = [] if args.duration is None else [("duration_s", args.duration)]
         scenario = load_scenario(args.scenario, overrides + duration)
+        check_output_dir(args.out, "--out")
     except ScenarioError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
 
     from drake_standup.simulate import simulate
 
-    try:
-        if args.live:
-            from drake_standup.live import run_live
+    if args.live:
+        from drake_standup.live import run_live
 
-            result = run_live(scenario, args.out, args.duration)
-        else:
-            result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
-    except ScenarioError as err:  # what only the built model can check (e.g. a body's name)
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+        result = run_live(scenario, args.out, args.duration)
+    else:
+        result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
     m = result.metrics
     for name, path in result.files.items():
         print(f"wrote {name}: {path}")

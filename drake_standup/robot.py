@@ -43,25 +43,15 @@ from pydrake.multibody.tree import (
     RevoluteJoint,
 )
 
+from drake_standup.config.inputs import CONTACT_FILE, TASK_FRAMES, robot_names
 from drake_standup.config.scenario import EFFORT_LIMIT_NM
 from drake_standup.meshes import cache_dir, converted_obj
-from drake_standup.resources import model_file
 
 DEFAULT_MODEL = "iCubGazeboV2_5"
-# Torque saturation of the authors' controller (SPEC 3): every actuator's effort limit,
-# which the whole-body controller reads from the plant. N m.
-CONTACT_FILE = model_file("icub_contact.yaml")
 
 
 class ModelError(ValueError):
     """Raised for a robot model that cannot be loaded (one-line message)."""
-
-
-def robot_names() -> list[str]:
-    """Names accepted for robot.model: every model icub-models ships."""
-    import icub_models
-
-    return sorted(icub_models.get_robot_names())
 
 
 def original_urdf(model_name: str) -> Path:
@@ -309,17 +299,9 @@ class Robot:
     contact_shapes: list[ContactShape]
     leaf_frames: list[LeafFrame]
 
-    # Task frame -> model frame: the controller speaks of hands and soles.
-    TASK_FRAMES = {
-        "l_sole": "l_sole",
-        "r_sole": "r_sole",
-        "l_hand": "l_hand_dh_frame",
-        "r_hand": "r_hand_dh_frame",
-        "l_thigh": "l_upper_leg_contact",
-        "r_thigh": "r_upper_leg_contact",
-        "buttocks": "buttocks_contact",
-        "seat": "seat_contact",
-    }
+    # Task frame -> model frame: the controller speaks of hands and soles. The table lives
+    # in config, whose validate checks that a model has these frames (scene_frames).
+    TASK_FRAMES = TASK_FRAMES
 
     def frame(self, plant: MultibodyPlant, task_name: str):
         """The plant frame behind a task frame name (see TASK_FRAMES)."""

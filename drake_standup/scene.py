@@ -5,16 +5,15 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from pathlib import Path
 
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, SceneGraph
 from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
-from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Context, DiagramBuilder
 
 from drake_standup.config import Scenario, chair_file
+from drake_standup.config.inputs import add_sdf
 from drake_standup.perturbations import scale_friction
 from drake_standup.resources import model_file
 from drake_standup.robot import Robot, add_icub, set_joint_positions
@@ -57,8 +56,9 @@ def add_scene(
         visual_max_faces=scenario.robot.visual_max_faces,
     )
     parser = Parser(plant)
-    (floor,) = _add_sdf(parser, model_file("floor.sdf"))
-    (chair,) = _add_sdf(parser, chair_file(scenario.chair.file))
+    (floor,) = add_sdf(parser, model_file("floor.sdf"))
+    # One model with a frame 'chair' (config.validate parsed it so).
+    (chair,) = add_sdf(parser, chair_file(scenario.chair.file))
     world = plant.world_frame()
     plant.WeldFrames(world, plant.GetFrameByName("floor", floor))
     plant.WeldFrames(
@@ -79,31 +79,12 @@ def add_scene(
     return Scene(plant, scene_graph, robot)
 
 
-def _add_sdf(parser: Parser, path: Path) -> list[ModelInstanceIndex]:
-    """Adds the models of an SDF file. One that names no other file (no <uri>:
-    meshes, includes) is parsed from its text: libsdformat loads its whole
-    schema again for every file it opens but not for a string (measured: 21 ms
-    against 0.5 ms for the floor; the two files were 70% of build_diagram).
-    Files with a <uri> stay files, so that their relative paths resolve."""
-    text = path.read_text()
-    if "<uri>" in text:
-        return parser.AddModels(str(path))
-    return parser.AddModelsFromString(text, "sdf")
-
-
 def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -> None:
-    """Puts the robot in the scenario's seated pose, at rest."""
+    """Puts the robot in the scenario's seated pose, at rest (config.validate checked the
+    joints' names)."""
     plant = scene.plant
     instance = scene.robot.model_instance
     init = scenario.initial
-    unknown = sorted(set(init.joints_rad) - set(scene.robot.joint_names))
-    if unknown:
-        from drake_standup.config import ScenarioError
-
-        raise ScenarioError(
-            f"initial.joints_rad: unknown joint(s) {', '.join(unknown)}; "
-            f"accepted: {', '.join(scene.robot.joint_names)}"
-        )
     set_joint_positions(plant, plant_context, instance, init.joints_rad)
     root = plant.GetBodyByName("root_link", instance)
     plant.SetFreeBodyPose(

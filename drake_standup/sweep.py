@@ -23,7 +23,7 @@ from pathlib import Path
 
 from drake_standup.arguments import OneLineErrorParser
 from drake_standup.cluster import run_on_cluster
-from drake_standup.config import ScenarioError, parse_scenario
+from drake_standup.config import ScenarioError, check_output_dir, parse_scenario
 from drake_standup.records import write_json
 from drake_standup.sweep_figures import draw_figure
 from drake_standup.sweep_file import RunSpec, SweepError, SweepSpec, expand, load_sweep
@@ -152,10 +152,10 @@ def main(argv: list[str] | None = None, prog: str = "python -m drake_standup.swe
             return 2
     try:
         spec = load_sweep(args.spec)
-    except SweepError as err:
+        out = check_output_dir(args.out or Path("out") / "sweeps" / spec.name, "--out")
+    except (SweepError, ScenarioError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    out = args.out or Path("out") / "sweeps" / spec.name
     try:
         result = run_sweep(spec, out, workers=args.workers, address=args.address, limit=args.limit)
     except OSError as err:  # e.g. no scheduler at --address

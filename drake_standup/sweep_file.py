@@ -15,6 +15,7 @@ import hashlib
 import itertools
 import json
 import math
+import reprlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,6 +28,7 @@ from drake_standup.config import (
     apply_overrides,
     expand_key_path,
     parse_scenario,
+    read_text_file,
 )
 from drake_standup.resources import find, shipped
 
@@ -92,17 +94,16 @@ def load_sweep(path: str | Path) -> SweepSpec:
     """Reads and checks a sweep file (a path, or the name of a shipped sweep); raises
     SweepError (one line)."""
     found = find("sweeps", path)
-    if found is None:
-        names = ", ".join(shipped("sweeps"))
-        raise SweepError(
-            f"sweep: file '{path}' not found; accepted: a YAML file or a shipped sweep: {names}"
-        )
+    accepted = f"a YAML file or a shipped sweep: {', '.join(shipped('sweeps'))}"
+    text = _checked(None, read_text_file, found or path, "sweep", accepted)
     try:
-        raw = yaml.safe_load(found.read_text()) or {}
+        raw = yaml.safe_load(text) or {}
     except yaml.YAMLError as err:
         raise SweepError(f"sweep {found}: not valid YAML ({' '.join(str(err).split())})") from None
     if not isinstance(raw, dict):
-        raise SweepError(f"sweep {found}: a mapping of {', '.join(TOP_KEYS)} expected")
+        raise SweepError(
+            f"sweep {found}: {reprlib.repr(raw)}; accepted: a mapping of {', '.join(TOP_KEYS)}"
+        )
     _known("sweep", raw, TOP_KEYS)
     if "base" not in raw:
         raise SweepError("base: missing; accepted: the path of a scenario YAML file")
@@ -129,7 +130,7 @@ def load_sweep(path: str | Path) -> SweepSpec:
     spec = SweepSpec(
         name=str(raw.get("name", found.stem)),
         base_path=base_path,
-        base_text=base_path.read_text(),
+        base_text=_checked(None, read_text_file, base_path, "base", "a scenario YAML file"),
         seed=_integer("seed", raw.get("seed", 0), 0),
         samples=_integer("samples", raw.get("samples", 1), 1),
         overrides=overrides,
@@ -330,9 +331,10 @@ def _paths(base, path: str, where: str) -> list[str]:
     return paths
 
 
-def _checked(where: str, function, *args):
-    """function(*args); a ScenarioError becomes a SweepError naming where."""
+def _checked(where: str | None, function, *args):
+    """function(*args); a ScenarioError becomes a SweepError naming where (None: its
+    message names the key already)."""
     try:
         return function(*args)
     except ScenarioError as err:
-        raise SweepError(f"{where}: {err}") from None
+        raise SweepError(str(err) if where is None else f"{where}: {err}") from None

@@ -214,8 +214,9 @@ def test_every_rule_names_a_key():
 
 
 # Values no rule bounds, and why: angles and names that only the model can check (the
-# joint limits clamp the posture targets; a name the model lacks is an error at build),
-# the chair file (checked to exist), lead_max_m (checked against lead_min_m).
+# joint limits clamp the posture targets; the names are checked against the model's URDF:
+# config.JOINT_TABLES, the pushed bodies), the model and the chair file (config/inputs.py),
+# lead_max_m (checked against lead_min_m).
 UNBOUNDED = (
     r"robot\.model|chair\.file|initial\.joints_rad\..*|phases\.\w+\.posture_rad\..*"
     r"|phases\.\w+\.base_pitch_rad"

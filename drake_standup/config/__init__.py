@@ -3,19 +3,23 @@
 scenario.py    the typed sections of a scenario (robot, human, advancement, standup, ...)
 controller.py  the whole-body controller's gains, weights and limits
 loading.py     a YAML file and overrides into those dataclasses (Drake's yaml_load_typed)
-rules.py       the bounds and accepted values of every field, and the checks across fields
+rules.py       the bounds and accepted values of every field, the keys naming joints, the
+               checks across fields, and validate: the one check of a scenario
+inputs.py      the files, folders and robot names a user gives (read_text_file, the chair
+               file, the robot model's frames, check_output_dir)
 errors.py      ScenarioError: one line naming the key or file
 """
 
 from drake_standup.config.controller import QP_SOLVERS, ControllerConfig
 from drake_standup.config.errors import ScenarioError
+from drake_standup.config.inputs import check_output_dir, read_text_file
 from drake_standup.config.loading import (
     apply_overrides,
     expand_key_path,
     load_scenario,
     parse_scenario,
 )
-from drake_standup.config.rules import RULES, Range, validate
+from drake_standup.config.rules import JOINT_TABLES, RULES, Range, validate
 from drake_standup.config.scenario import (
     DEFAULT_SCENARIO,
     EFFORT_LIMIT_NM,
@@ -40,6 +44,7 @@ from drake_standup.config.scenario import (
 __all__ = [
     "DEFAULT_SCENARIO",
     "EFFORT_LIMIT_NM",
+    "JOINT_TABLES",
     "QP_SOLVERS",
     "RULES",
     "SCENARIO_DIR",
@@ -62,8 +67,10 @@ __all__ = [
     "VisualizationConfig",
     "apply_overrides",
     "chair_file",
+    "check_output_dir",
     "expand_key_path",
     "load_scenario",
     "parse_scenario",
+    "read_text_file",
     "validate",
 ]

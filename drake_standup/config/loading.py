@@ -8,6 +8,7 @@ line) are one more YAML layer through the same loader. What the types alone cann
 """
 
 import re
+import reprlib
 import typing
 from collections.abc import Iterable
 from pathlib import Path
@@ -16,6 +17,7 @@ import yaml
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 
 from drake_standup.config.errors import ScenarioError
+from drake_standup.config.inputs import read_text_file
 from drake_standup.config.legacy import read_legacy
 from drake_standup.config.rules import _format, _nodes, _pattern, validate
 from drake_standup.config.scenario import DEFAULT_SCENARIO, Scenario
@@ -26,12 +28,9 @@ def load_scenario(path: str | Path | None = None, overrides: Iterable = ()) -> S
     """Loads a scenario file (a path, or the name of a shipped scenario), applies overrides
     [(key path, value)] and validates; raises ScenarioError (one line)."""
     found = find("scenarios", path) if path is not None else DEFAULT_SCENARIO
-    if found is None:
-        raise ScenarioError(
-            f"scenario: file '{path}' not found; accepted: a YAML file or a shipped "
-            f"scenario: {', '.join(shipped('scenarios'))}"
-        )
-    return parse_scenario(found.read_text(), str(found), overrides)
+    accepted = f"a YAML file or a shipped scenario: {', '.join(shipped('scenarios'))}"
+    text = read_text_file(found or path, "scenario", accepted)
+    return parse_scenario(text, str(found), overrides)
 
 
 def parse_scenario(text: str, where: str = "scenario", overrides: Iterable = ()) -> Scenario:
@@ -42,7 +41,8 @@ def parse_scenario(text: str, where: str = "scenario", overrides: Iterable = ())
         raise ScenarioError(f"scenario {where}: not valid YAML ({_one_line(err)})") from None
     if not isinstance(raw, dict | None):
         raise ScenarioError(
-            f"scenario {where}: {raw!r}; accepted: a mapping of {', '.join(_fields(Scenario))}"
+            f"scenario {where}: {reprlib.repr(raw)}; accepted: a mapping of "
+            f"{', '.join(_fields(Scenario))}"
         )
     return apply_overrides(_load(raw or {}, Scenario()), overrides)
 

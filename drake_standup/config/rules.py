@@ -1,7 +1,9 @@
-"""Bounds and accepted values of every field (RULES), and the checks across fields.
+"""Bounds and accepted values of every field (RULES), the keys that name joints of the
+robot model (JOINT_TABLES), and the checks across fields.
 
-validate(scenario) is what the types alone cannot say; every message is one line naming
-the key path and what it accepts.
+validate(scenario) is the one check of a scenario, of what the types alone cannot say:
+RULES, the checks across fields, the robot model's names and the chair file
+(config/inputs.py); every message is one line naming the key path and what it accepts.
 """
 
 import math
@@ -9,14 +11,14 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-import icub_models
 import yaml
 from pydrake.common.yaml import yaml_dump_typed
 from pydrake.systems.analysis import GetIntegrationSchemes
 
 from drake_standup.config.controller import QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
-from drake_standup.config.scenario import Scenario, chair_file
+from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
+from drake_standup.config.scenario import Scenario
 from drake_standup.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
 
 
@@ -28,12 +30,15 @@ class Range:
     high: float = math.inf
     low_open: bool = False
     high_open: bool = False
+    text: str = ""  # what an error says is accepted, if more than the bounds
 
     def accepts(self, x) -> bool:
         above = x > self.low if self.low_open else x >= self.low
         return above and (x < self.high if self.high_open else x <= self.high)
 
     def __str__(self) -> str:
+        if self.text:
+            return self.text
         if self.high == math.inf:
             return f"a number {'>' if self.low_open else '>='} {self.low:g}"
         left, right = "(["[not self.low_open], ")]"[not self.high_open]
@@ -42,6 +47,13 @@ class Range:
 
 INTERVAL = "interval"  # two numbers [low, high] with low < high
 POSITIVE, NON_NEGATIVE, FRACTION = Range(low_open=True), Range(), Range(high=1.0)
+# The controller acts at the plant's steps (controller_period_s is a whole multiple of
+# plant.time_step), and the integrator's steps and the convergence study follow them.
+PLANT_STEP = Range(
+    low_open=True,
+    text="a discrete plant's step, a number > 0 s (0, a continuous plant, cannot run the "
+    "controller: it acts at the plant's steps)",
+)
 
 # What the values at some key paths accept: a Range (of each entry of a list too), a length
 # n (a list of n entries), INTERVAL or a tuple of accepted strings. The key paths are
@@ -78,7 +90,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     ),
     (
         NON_NEGATIVE,
-        "plant.time_step human.pulls[*].start_s human.pulls[*].ramp_s "
+        "human.pulls[*].start_s human.pulls[*].ramp_s "
         "human.reactive.start_s human.reactive.ramp_s human.reactive.stiffness_N_per_m "
         "human.reactive.damping_Ns_per_m human.reactive.travel_m "
         "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
@@ -93,6 +105,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "perturbation.noise_seed plant.sap_near_rigid_threshold simulator.target_realtime_rate "
         "simulator.start_time fall.min_root_height_m",
     ),
+    (PLANT_STEP, "plant.time_step"),
     (Range(low=1.0), "advancement.psi_dot_upper"),
     (Range(high=1.0, high_open=True), "advancement.taper_from_progress"),
     (Range(high=1.0, high_open=True), "controller.stance_from_progress"),
@@ -121,6 +134,19 @@ def _pattern(rule: str) -> re.Pattern:
 
 
 _COMPILED = [(_pattern(rule), accepted) for accepted, rules in RULES for rule in rules.split()]
+
+# Key paths (patterns as in RULES) whose mapping keys, or list entries, name joints of
+# robot.model: checked against the joints of its URDF, so that no unknown name reaches
+# the plant.
+JOINT_TABLES = (
+    "initial.joints_rad",
+    "controller.posture_weight_by_joint",
+    "controller.stance_posture_weight_by_joint",
+    "controller.stance_arm_weight_by_joint",
+    "phases.*.posture_rad",
+    "controller.seat_hinge_joints",
+)
+_JOINT_TABLES = [_pattern(table) for table in JOINT_TABLES]
 
 
 def _nodes(data, steps: tuple = (), leaves: bool = False) -> Iterator[tuple[list, object]]:
@@ -162,33 +188,65 @@ def _check(key: str, value, accepted) -> None:
 
 
 def validate(scenario: Scenario) -> Scenario:
-    """Checks what the types alone cannot; raises ScenarioError (one line). Returns
-    scenario."""
-    for steps, value in _nodes(yaml.safe_load(yaml_dump_typed(scenario))):
+    """The one check of a scenario before anything simulates: RULES, the checks across
+    fields, the robot model's names (its frames, and every joint and body the scenario
+    names) and the chair file. Raises ScenarioError (one line); returns scenario."""
+    data = yaml.safe_load(yaml_dump_typed(scenario))
+    _check_rules(data)
+    _check_across_fields(scenario)
+    _check_names(scenario, data, check_robot_model(scenario.robot.model))
+    check_chair_file(scenario.chair.file)
+    return scenario
+
+
+def _check_rules(data: dict) -> None:
+    """Every value of data (the scenario as plain YAML data) against RULES."""
+    for steps, value in _nodes(data):
         key = _format(steps)
         _check(key, value, None)
         for pattern, accepted in _COMPILED:
             if pattern.fullmatch(key):
                 _check(key, value, accepted)
-    if scenario.robot.model not in sorted(icub_models.get_robot_names()):
+
+
+def _check_names(scenario: Scenario, data: dict, names: ModelNames) -> None:
+    """The joints of JOINT_TABLES and the pushed bodies vs the robot model's."""
+    model = scenario.robot.model
+    for steps, table in _nodes(data):
+        key = _format(steps)
+        if any(pattern.fullmatch(key) for pattern in _JOINT_TABLES):
+            unknown = sorted(set(table) - set(names.joints))
+            if unknown:
+                raise ScenarioError(
+                    f"{key}: unknown joint(s) {', '.join(unknown)}; accepted: the joints of "
+                    f"{model}: {', '.join(names.joints)}"
+                )
+    reduced = scenario.robot.reduced
+    bodies = names.bodies(reduced)
+    for i, push in enumerate(scenario.perturbation.pushes):
+        if push.body in bodies:
+            continue
+        what = "unknown"
+        if push.body in names.links:  # a massless link of the reduced model
+            what = "is a frame of the reduced model (robot.reduced: true), not a body"
         raise ScenarioError(
-            f"robot.model: unknown model '{scenario.robot.model}'; "
-            f"accepted: {', '.join(sorted(icub_models.get_robot_names()))}"
+            f"perturbation.pushes[{i}].body: '{push.body}' {what}; accepted: the bodies of "
+            f"{model}{' reduced' if reduced else ''}: {', '.join(bodies)}"
         )
-    # The controller's period is a whole multiple of a discrete plant's step: the plant
-    # reads its actuation input only at its own steps, so a faster controller is wasted
-    # work and a period off the plant's grid jitters.
+
+
+def _check_across_fields(scenario: Scenario) -> None:
+    """What one value says of another: the controller's period on the plant's step grid,
+    the pulls' ramps, the reactive helper's path and leads."""
+    # The controller's period is a whole multiple of the plant's step: the plant reads its
+    # actuation input only at its own steps, so a faster controller is wasted work and a
+    # period off the plant's grid jitters.
     step, period = scenario.plant.time_step, scenario.controller_period_s
-    ratio = period / step if step > 0 else 1.0  # a continuous plant: any period
+    ratio = period / step
     if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
         raise ScenarioError(
             f"controller_period_s: {period}; accepted: a whole multiple of plant.time_step "
             f"({step}), e.g. {step} or {2 * step}"
-        )
-    if not chair_file(scenario.chair.file).is_file():
-        raise ScenarioError(
-            f"chair.file: '{scenario.chair.file}' not found; accepted: an SDF file path "
-            "(absolute or relative to the current directory), or models/chair.sdf"
         )
     for i, pull in enumerate(scenario.human.pulls):
         if 2 * pull.ramp_s > pull.duration_s:
@@ -214,4 +272,3 @@ def validate(scenario: Scenario) -> Scenario:
             f"human.reactive.lead_max_m: {reactive.lead_max_m}; accepted: a number >= "
             f"lead_min_m ({reactive.lead_min_m})"
         )
-    return scenario

@@ -372,6 +372,7 @@ class Scenario:
 
 
 def chair_file(name: str) -> Path:
-    """chair.file as a path: the shipped models/chair.sdf, or the user's own file."""
-    own = Path(name)
-    return own if own.is_absolute() or own.is_file() else data_root() / name
+    """chair.file as a path: the user's own file (or folder: config.inputs names it), else a
+    shipped one such as models/chair.sdf, else the name as given (config.inputs: missing)."""
+    own, shipped = Path(name), data_root() / name
+    return shipped if not own.is_absolute() and not own.exists() and shipped.is_file() else own
