@@ -15,7 +15,7 @@ from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
 from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
 
-from drake_standup.config import Scenario
+from drake_standup.config import Scenario, validate
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.human import HumanWrenchSource
 from drake_standup.robot import actuated_joints
@@ -77,6 +77,7 @@ def build_diagram(
     """
     if controller not in CONTROLLERS:
         raise ValueError(f"controller: '{controller}'; accepted: {', '.join(CONTROLLERS)}")
+    validate(scenario)  # the one check of a scenario's inputs, however it was made
     hold = scenario.seat_hold
     seat_hold = controller == "seat_hold"
     station = make_station(
@@ -207,8 +208,8 @@ def add_seat_hold(builder, scene: Scene, scenario: Scenario, desired_state, actu
     q0 = plant.GetPositions(plant_context, instance)
     u_ff = plant.MakeActuationMatrix().T @ (-plant.CalcGravityGeneralizedForces(plant_context))
     q_index = actuated_joints(plant, instance).q_index
-    desired_state = np.concatenate([q0[q_index], np.zeros(len(q_index))])
-    setpoint = builder.AddNamedSystem("seat_hold_setpoint", ConstantVectorSource(desired_state))
+    x0 = np.concatenate([q0[q_index], np.zeros(len(q_index))])
+    setpoint = builder.AddNamedSystem("seat_hold_setpoint", ConstantVectorSource(x0))
     feedforward = builder.AddNamedSystem("seat_hold_feedforward", ConstantVectorSource(u_ff))
     builder.Connect(setpoint.get_output_port(), desired_state)
     builder.Connect(feedforward.get_output_port(), actuation)

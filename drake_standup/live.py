@@ -322,16 +322,34 @@ class LiveSession:
             self._wall, self._sim = wall, t
 
 
-def run_live(
-    scenario: Scenario,
-    out_dir: Path,
-    duration_s: float | None = None,
-    realtime_rate: float = 1.0,
-    chunk_s: float = 0.05,
+def run_session(
+    scenario: Scenario, session: LiveSession, out_dir: Path | None = None, chunk_s: float = 0.05
 ) -> RunResult:
-    """The live run (runner.py's prepare, advance and collect, with the page between the
-    chunks); prints the page's address, writes the run's files (no psi = t run: nobody
-    knows the pull in advance) and returns its RunResult."""
+    """A live run with session at the page: runner.py's prepare, advance and collect, the
+    page between the chunks; the run's files into out_dir if given (no psi = t run:
+    nobody knows the pull in advance)."""
+    run = prepare(scenario, session.meshcat, make_human=session.make_human, live_transforms=True)
+    session.started(run)
+    chunk_s = on_plant_grid(chunk_s, scenario)
+    chunk = 0
+    while not finished(run):
+        chunk += 1
+        advance(run, chunk * chunk_s)
+        if session.after_chunk(run):
+            break
+    if run.failure_reason is None:
+        run.failure_reason = session.fell  # a fall that no Reset undid
+    result = collect(run)
+    if out_dir is not None:
+        result.files = write_run(run, result, out_dir)
+    return result
+
+
+def run_live(
+    scenario: Scenario, out_dir: Path, duration_s: float | None = None, realtime_rate: float = 1.0
+) -> RunResult:
+    """The live run: prints the page's address, runs to --duration (or Stop, Escape,
+    Ctrl-C) paced at realtime_rate, writes the run's files and returns its RunResult."""
     scenario = copy.deepcopy(scenario)
     scenario.duration_s = DEFAULT_DURATION_S if duration_s is None else duration_s
     scenario.simulator.target_realtime_rate = realtime_rate
@@ -344,19 +362,7 @@ def run_live(
 
     previous = signal.signal(signal.SIGINT, interrupt)
     try:
-        run = prepare(scenario, meshcat, make_human=session.make_human, live_transforms=True)
-        session.started(run)
-        chunk_s = on_plant_grid(chunk_s, scenario)
-        chunk = 0
-        while not finished(run):
-            chunk += 1
-            advance(run, chunk * chunk_s)
-            if session.after_chunk(run):
-                break
-        if run.failure_reason is None:
-            run.failure_reason = session.fell  # a fall that no Reset undid
-        result = collect(run)
-        result.files = write_run(run, result, out_dir)
+        result = run_session(scenario, session, out_dir)
     finally:
         signal.signal(signal.SIGINT, previous)
     if session.stopped_by is not None:

@@ -24,7 +24,7 @@ from pydrake.multibody.plant import CoulombFriction, ExternallyAppliedSpatialFor
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
 from drake_standup.caching import declare_cached
-from drake_standup.config import Push, Scenario, ScenarioError
+from drake_standup.config import Push, Scenario
 from drake_standup.robot import Robot
 
 # Time tolerance of window and period boundaries: Drake's sample times
@@ -49,23 +49,16 @@ def push_active(push: Push, t: float) -> bool:
 class PushSource(LeafSystem):
     """Outputs spatial_forces (the active pushes, for the plant's
     applied_spatial_force input: a world force at the origin of each pushed
-    body) and push_force_W (3: the sum of the active pushes' forces, N).
-
-    Raises ScenarioError for a body the robot does not have.
+    body) and push_force_W (3: the sum of the active pushes' forces, N). The
+    bodies are the robot's (config.validate checks their names).
     """
 
     def __init__(self, plant: MultibodyPlant, robot: Robot, pushes: list[Push]):
         super().__init__()
-        names = robot_body_names(plant, robot)
         self._pushes = list(pushes)
         # One preallocated force per push; only its force changes (never, here).
         self._applied = []
-        for i, push in enumerate(self._pushes):
-            if push.body not in names:
-                raise ScenarioError(
-                    f"perturbation.pushes[{i}].body: '{push.body}' unknown; "
-                    f"accepted: {', '.join(names)}"
-                )
+        for push in self._pushes:
             applied = ExternallyAppliedSpatialForce()
             applied.body_index = plant.GetBodyByName(push.body, robot.model_instance).index()
             applied.p_BoBq_B = np.zeros(3)

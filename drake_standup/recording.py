@@ -21,7 +21,8 @@ def export_diagram(diagram: Diagram, directory: Path, stem: str = "standup") -> 
     """Writes <stem>.dot and, where graphviz's dot exists, <stem>.svg."""
     directory.mkdir(parents=True, exist_ok=True)
     dot_path = directory / f"{stem}.dot"
-    dot_path.write_text(diagram.GetGraphvizString(max_depth=1))
+    # Two levels: the station's and the stand-up controller's systems inside their boxes.
+    dot_path.write_text(diagram.GetGraphvizString(max_depth=2))
     written = [dot_path]
     dot = shutil.which("dot")
     if dot is None:

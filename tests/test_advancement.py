@@ -92,11 +92,11 @@ def test_interaction_law_value_matches_the_authors_ratio():
     )
 
 
-def _simulate_advancement(cfg, v, omega_f, tangent, t_end, advances=None):
+def _simulate_advancement(cfg, v, omega_f, tangent, t_end, advances=True):
     system = TrajectoryAdvancement(cfg)
     context = system.CreateDefaultContext()
-    if advances is not None:
-        system.GetInputPort("advances").FixValue(context, [float(advances)])
+    system.GetInputPort("advances").FixValue(context, [float(advances)])
+    system.GetInputPort("path_progress").FixValue(context, [0.0])  # no taper
     # CoM on its reference: the lead gate is open.
     system.GetInputPort("com_W").FixValue(context, np.zeros(3))
     system.GetInputPort("x_d_W").FixValue(context, np.zeros(3))

@@ -14,7 +14,7 @@ import pytest
 
 from drake_standup import bench
 from drake_standup.config import Scenario
-from drake_standup.controller import WholeBodyController
+from drake_standup.control.controller import TIMING
 
 DURATION_S = 0.05
 REPEAT = 2
@@ -31,7 +31,7 @@ TINY = [
     "--no-run-diagram",
 ]
 RUNS = ("plant_seat_hold", "closed_loop_recording", "closed_loop")
-COLUMNS = [name.removesuffix("_s") + "_us" for name in WholeBodyController.TIMING]
+COLUMNS = [name.removesuffix("_s") + "_us" for name in TIMING]
 
 
 def _positive(x) -> bool:

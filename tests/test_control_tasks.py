@@ -12,10 +12,10 @@ import pytest
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
+from drake_standup.control.model import contact_specs
 from drake_standup.control.qp import ContactCommands, ContactMap, QpLayout, Task, WholeBodyQp
 from drake_standup.control.references import TaskReferences, static_lean
 from drake_standup.control.terms import RobotKinematics, RobotTerms
-from drake_standup.controller import WholeBodyController
 from drake_standup.scene import add_scene, set_seated_state
 
 TARGET_RAD_PER_S2 = 2.0
@@ -52,6 +52,7 @@ def _references(standup_state: int) -> TaskReferences:
         vertical_weight_scale=1.0,
         stance=0.0,
         next_height_integral=0.0,
+        next_momentum_integral=None,
         next_posture=None,
     )
 
@@ -71,7 +72,7 @@ def seated_state():
     context = plant.CreateDefaultContext()
     set_seated_state(scene, context, scenario)
     x = plant.GetPositionsAndVelocities(context, robot.model_instance)
-    specs = WholeBodyController(plant, robot, ControllerConfig()).contact_specs
+    specs = contact_specs(plant, robot, ControllerConfig())
     kinematics = RobotKinematics(
         plant,
         robot,

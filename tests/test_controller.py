@@ -1,4 +1,5 @@
-"""The whole-body controller (drake_standup.controller, drake_standup/control/).
+"""The whole-body controller (drake_standup/control/): the QP's solution, the model's
+terms, the help, the fallbacks.
 
 Every check recomputes its reference from Drake's own functions (CalcMassMatrix,
 CalcBiasTerm, CalcGravityGeneralizedForces, CalcJacobianSpatialVelocity, the CoM and
@@ -6,10 +7,12 @@ momentum functions), frame poses and the joints' damping, independently of the
 controller's code; a second QP solver checks the first.
 """
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
+from pydrake.common.value import Value
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import JacobianWrtVariable
@@ -17,11 +20,20 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
-from drake_standup.control.references import helpful_force
+from drake_standup.control.controller import DIAGNOSTICS, WholeBodyController
+from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
+from drake_standup.control.qp import as_slice
+from drake_standup.control.references import (
+    ReferenceGenerator,
+    StandupSchedule,
+    TaskReferenceGenerator,
+    helpful_force,
+)
+from drake_standup.control.schedule import CONTACTS, contact_commands, phase_seat_hold
 from drake_standup.control.terms import RobotKinematics
-from drake_standup.controller import WholeBodyController
 from drake_standup.phases import PhaseTable
 from drake_standup.scene import add_scene, set_seated_state
+from drake_standup.state_machine import initial_mode
 
 G = 9.81
 N_SAMPLES = 12
@@ -39,24 +51,88 @@ def scene():
     return scene, x0
 
 
-def _controller(scene, **config):
-    plant, robot = scene.plant, scene.robot
-    controller = WholeBodyController(plant, robot, ControllerConfig(**config))
-    return controller, controller.CreateDefaultContext()
-
-
+PERIOD_S = 0.001
 NO_PULL = np.zeros(12)
 
 
-def _fix_inputs(controller, context, x, com_reference, plan, hand_wrenches=NO_PULL):
-    """plan: [state, seat_scale, feet_scale] (the seat pads seated: no unloading) or the
-    whole contact plan."""
-    if len(plan) == 3:
-        plan = [*plan, math.nan, math.nan, math.nan]
-    controller.GetInputPort("robot_state").FixValue(context, x)
-    controller.GetInputPort("com_reference").FixValue(context, com_reference)
-    controller.GetInputPort("contact_plan").FixValue(context, plan)
-    controller.GetInputPort("hand_wrenches_W").FixValue(context, hand_wrenches)
+class _Rig:
+    """The controller's model, the task references and the whole-body controller wired
+    as in the stand-up controller, their inputs fixed: one tick from given inputs."""
+
+    def __init__(self, scene, **config):
+        """config: ControllerConfig's fields; the nominal model (no weighing) unless
+        mass_estimation_filter_s says otherwise."""
+        plant, robot = scene.plant, scene.robot
+        self.config = ControllerConfig(**{"mass_estimation_filter_s": 0.0} | config)
+        self.table = PhaseTable()
+        self.specs = contact_specs(plant, robot, self.config)
+        joints = ControllerJoints.of(plant, robot)
+        g = -plant.gravity_field().gravity_vector()[2]
+        schedule = StandupSchedule(
+            self.table, self.config, joints.names, joints.q_min, joints.q_max
+        )
+        builder = DiagramBuilder()
+        model = builder.AddSystem(ControllerModel(plant, robot, self.specs, self.config, PERIOD_S))
+        references = builder.AddSystem(
+            TaskReferenceGenerator(
+                ReferenceGenerator(self.config, schedule, as_slice(joints.q_indices), PERIOD_S, g),
+                PERIOD_S,
+            )
+        )
+        self.controller = builder.AddSystem(
+            WholeBodyController(plant, self.specs, joints, self.config, self.table, PERIOD_S)
+        )
+        builder.Connect(model.GetOutputPort("terms"), references.GetInputPort("terms"))
+        builder.Connect(model.GetOutputPort("terms"), self.controller.GetInputPort("terms"))
+        builder.Connect(
+            references.GetOutputPort("task_references"),
+            self.controller.GetInputPort("task_references"),
+        )
+        for name, systems in {
+            "robot_state": (model,),
+            "hand_wrenches_W": (model, references),
+            "pads_vertical_force_N": (model,),
+            "standup_state": (model, references),
+            "contact_commands": (model, self.controller),
+            "com_reference": (references,),
+            "path_progress": (references,),
+        }.items():
+            builder.ExportInput(systems[0].GetInputPort(name), name)
+            for system in systems[1:]:
+                builder.ConnectInput(name, system.GetInputPort(name))
+        self.diagram = builder.Build()
+        self.context = self.diagram.CreateDefaultContext()
+        self.controller_context = self.controller.GetMyContextFromRoot(self.context)
+
+    def fix(self, x, com_reference, standup_state, hands=NO_PULL):
+        """Inputs of a tick in standup_state with every seat pad seated."""
+        seated = np.full(3, math.nan)
+        mode = dataclasses.replace(initial_mode(np.zeros(3)), state=standup_state)
+        commands = contact_commands(
+            self.config, seated, np.zeros(3), None, phase_seat_hold(mode, self.table)
+        )
+        inputs = {
+            "robot_state": x,
+            "hand_wrenches_W": hands,
+            "pads_vertical_force_N": [0.0],
+            "standup_state": [standup_state],
+            "com_reference": com_reference,
+            "path_progress": [1.0],
+        }
+        for name, value in inputs.items():
+            self.diagram.GetInputPort(name).FixValue(self.context, value)
+        self.diagram.GetInputPort("contact_commands").FixValue(
+            self.context, Value[object](commands)
+        )
+
+    def tick(self):
+        return self.controller.CalcTick(self.controller_context).solution
+
+    def diagnostics(self) -> dict[str, float]:
+        values = self.controller.GetOutputPort("diagnostics").Eval(self.controller_context)
+        return {
+            name: part[0] for name, part in DIAGNOSTICS.unpack(values).items() if len(part) == 1
+        }
 
 
 def _com(plant, instance, x):
@@ -112,8 +188,8 @@ def test_solution_satisfies_dynamics_and_contact_limits(scene, standup_state):
     plant, robot = scene.plant, scene.robot
     instance = robot.model_instance
     config = ControllerConfig()
-    controller, context = _controller(scene)
-    specs = {spec.frame: spec for spec in controller.contact_specs}
+    rig = _Rig(scene)
+    specs = {spec.frame: spec for spec in rig.specs}
     B = plant.MakeActuationMatrix()
     D = _joint_damping(plant, instance)
     world = plant.world_frame()
@@ -131,10 +207,10 @@ def test_solution_satisfies_dynamics_and_contact_limits(scene, standup_state):
         hands = np.concatenate([rng.normal(scale=[2, 2, 2, 20, 20, 20]) for _ in range(2)])
         com = _com(plant, instance, x)
         reference = np.concatenate([com + rng.normal(scale=0.02, size=3), np.zeros(6)])
-        _fix_inputs(controller, context, x, reference, [standup_state, 1.0, 1.0], hands)
-        solution = controller.CalcTick(context).solution
+        rig.fix(x, reference, standup_state, hands)
+        solution = rig.tick()
         assert solution.ok
-        assert sorted(solution.frames) == sorted(WholeBodyController.CONTACTS)
+        assert sorted(solution.frames) == sorted(CONTACTS)
 
         plant.SetPositionsAndVelocities(plant_context, instance, x)
         v = x[plant.num_positions() :]
@@ -184,9 +260,8 @@ def test_cop_boxes_lie_on_their_pads(scene):
     context = plant.CreateDefaultContext()
     plant.SetPositionsAndVelocities(context, robot.model_instance, x0)
     pads = {shape["name"]: shape for shape in yaml.safe_load(CONTACT_FILE.read_text())["shapes"]}
-    controller, _ = _controller(scene)
     pad_of = {"seat": "buttocks_pad", "l_sole": "l_sole_pad", "r_sole": "r_sole_pad"}
-    for spec in controller.contact_specs:
+    for spec in contact_specs(plant, robot, ControllerConfig()):
         if spec.point:
             continue
         pad = pads[pad_of[spec.frame]]
@@ -210,10 +285,10 @@ def test_static_seated_reference_balances_gravity(scene):
     scene, x0 = scene
     plant, robot = scene.plant, scene.robot
     instance = robot.model_instance
-    controller, context = _controller(scene)
+    rig = _Rig(scene)
     com = _com(plant, instance, x0)
-    _fix_inputs(controller, context, x0, np.concatenate([com, np.zeros(6)]), [1.0, 1.0, 1.0])
-    solution = controller.CalcTick(context).solution
+    rig.fix(x0, np.concatenate([com, np.zeros(6)]), 1)
+    solution = rig.tick()
     assert solution.ok
 
     plant_context = plant.CreateDefaultContext()
@@ -286,8 +361,7 @@ def test_hold_point_velocity_and_bias_acceleration_by_finite_differences(scene):
     scene, x0 = scene
     plant, robot = scene.plant, scene.robot
     instance = robot.model_instance
-    controller, _ = _controller(scene)
-    held = [spec for spec in controller.contact_specs if spec.constrained]
+    held = [spec for spec in contact_specs(plant, robot, ControllerConfig()) if spec.constrained]
     names = [spec.frame for spec in held]
     kinematics = RobotKinematics(
         plant,
@@ -357,14 +431,12 @@ def test_contacts_cancel_all_but_the_helpful_pull(scene, moving):
     plant, robot = scene.plant, scene.robot
     instance = robot.model_instance
     config = ControllerConfig()
-    controller, context = _controller(scene, momentum_weight=1e4)
+    rig = _Rig(scene, momentum_weight=1e4)
     com = _com(plant, instance, x0)
     xd_dot = np.array([0.1, 0.0, 0.0]) if moving else np.zeros(3)
     hands = np.tile([0.0, 0.0, 0.0, 15.0, 0.0, 15.0], 2)
-    _fix_inputs(
-        controller, context, x0, np.concatenate([com, xd_dot, np.zeros(3)]), [2, 1, 1], hands
-    )
-    solution = controller.CalcTick(context).solution
+    rig.fix(x0, np.concatenate([com, xd_dot, np.zeros(3)]), 2, hands)
+    solution = rig.tick()
     assert solution.ok
     mass = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
     kd_x = 2.0 * config.com_damping_ratio * np.sqrt(PhaseTable().seated.com_kp_per_s2[0])
@@ -383,22 +455,21 @@ def _infeasible_ticks(scene, break_fallback: bool):
     fails too. Returns (last, actuation, diagnostics)."""
     scene, x0 = scene
     plant, robot = scene.plant, scene.robot
-    controller, context = _controller(scene, min_normal_force_N=500.0)
+    rig = _Rig(scene, min_normal_force_N=500.0)
     com = _com(plant, robot.model_instance, x0)
-    _fix_inputs(controller, context, x0, np.concatenate([com, np.zeros(6)]), [1, 1, 1])
+    rig.fix(x0, np.concatenate([com, np.zeros(6)]), 1)
     last = np.linspace(-1.0, 1.0, plant.num_actuators())
-    context.get_mutable_discrete_state(0).SetFromVector(last)
+    rig.controller_context.get_mutable_discrete_state(0).SetFromVector(last)
     if break_fallback:
         # Build the program the ticks use, then make its fallback fail.
-        controller.CalcTick(context)
-        for program in controller._programs.values():
-            program.qp._solve_relaxed = lambda H, g: (np.full(len(g), np.nan), False)
-    simulator = Simulator(controller, context)
+        rig.tick()
+        program = rig.controller.program((True,) * len(CONTACTS))
+        program.qp._solve_relaxed = lambda H, g: (np.full(len(g), np.nan), False)
+    simulator = Simulator(rig.diagram, rig.context)
     simulator.Initialize()  # the initialization update
     simulator.AdvanceTo(0.0025)  # periodic updates at 0, 1 and 2 ms
-    actuation = controller.GetOutputPort("actuation").Eval(context)
-    diagnostics = controller.GetOutputPort("diagnostics").Eval(context)
-    return last, actuation, dict(zip(controller.DIAGNOSTICS, diagnostics, strict=True))
+    actuation = rig.controller.GetOutputPort("actuation").Eval(rig.controller_context)
+    return last, actuation, rig.diagnostics()
 
 
 def test_an_infeasible_qp_falls_back_to_the_relaxed_program_and_counts(scene):
@@ -429,9 +500,9 @@ def _solve_with(scene, solvers, *, seed, **config):
     com = _com(plant, instance, x)
     solutions = []
     for name in solvers:
-        controller, context = _controller(scene, qp_solver=name, **config)
-        _fix_inputs(controller, context, x, np.concatenate([com, np.zeros(6)]), [2, 1, 1])
-        solutions.append(controller.CalcTick(context).solution)
+        rig = _Rig(scene, qp_solver=name, **config)
+        rig.fix(x, np.concatenate([com, np.zeros(6)]), 2)
+        solutions.append(rig.tick())
     return solutions
 
 
@@ -465,13 +536,13 @@ def test_seat_hinge_follows_the_plan(scene):
     instance = robot.model_instance
     x = _random_state(plant, instance, x0, np.random.default_rng(12))
     reference = np.concatenate([_com(plant, instance, x), np.zeros(6)])
-    controller, context = _controller(scene)
+    rig = _Rig(scene)
     for standup_state in (1, 2, 1):
-        _fix_inputs(controller, context, x, reference, [standup_state, 1, 1])
-        solution = controller.CalcTick(context).solution
-        fresh, fresh_context = _controller(scene)
-        _fix_inputs(fresh, fresh_context, x, reference, [standup_state, 1, 1])
-        expected = fresh.CalcTick(fresh_context).solution
+        rig.fix(x, reference, standup_state)
+        solution = rig.tick()
+        fresh = _Rig(scene)
+        fresh.fix(x, reference, standup_state)
+        expected = fresh.tick()
         assert solution.ok and expected.ok
         np.testing.assert_allclose(solution.tau, expected.tau, atol=1e-9)
         np.testing.assert_allclose(solution.vdot, expected.vdot, atol=1e-9)
@@ -480,26 +551,22 @@ def test_seat_hinge_follows_the_plan(scene):
 
 
 def _solution_in_state(scene, x, reference, standup_state):
-    controller, context = _controller(scene)
-    _fix_inputs(controller, context, x, reference, [standup_state, 1, 1])
-    return controller.CalcTick(context).solution
+    rig = _Rig(scene)
+    rig.fix(x, reference, standup_state)
+    return rig.tick()
 
 
 def test_ports_and_config(scene):
-    """Port names and sizes the diagram relies on; the config loads from YAML typed."""
+    """The ports the stand-up controller wires (control/controller.py's docstring); the
+    config loads from YAML typed."""
     scene, _ = scene
-    controller, _ = _controller(scene)
-    plant = scene.plant
-    sizes = {
-        "robot_state": plant.num_positions() + plant.num_velocities(),
-        "com_reference": 9,
-        "contact_plan": 6,
-        "hand_wrenches_W": 12,
-    }
-    for name, size in sizes.items():
-        assert controller.GetInputPort(name).size() == size
+    rig = _Rig(scene)
+    controller, plant = rig.controller, scene.plant
+    inputs = [controller.get_input_port(i).get_name() for i in range(controller.num_input_ports())]
+    assert inputs == ["terms", "task_references", "contact_commands"]
     assert controller.GetOutputPort("actuation").size() == plant.num_actuators()
-    assert controller.GetOutputPort("diagnostics").size() == len(controller.DIAGNOSTICS)
+    assert controller.GetOutputPort("diagnostics").size() == DIAGNOSTICS.size
+    assert controller.GetOutputPort("commanded_normal_forces_N").size() == len(CONTACTS)
     config = yaml_load_typed(
         schema=ControllerConfig, data="qp_solver: clarabel\nposture_weight: 0.5\n"
     )

@@ -59,8 +59,8 @@ def test_plant_receives_exactly_the_scripted_force():
     scenario = Scenario()
     scenario.human = HumanConfig(pulls=PULLS)
     built = build_diagram(scenario)
-    plant = built.scene.plant
-    robot = built.scene.robot
+    plant = built.station.scene.plant
+    robot = built.station.scene.robot
     root = built.diagram.CreateDefaultContext()
     plant_context = plant.GetMyContextFromRoot(root)
     hand_bodies = [robot.frame(plant, h).body().index() for h in ("l_hand", "r_hand")]

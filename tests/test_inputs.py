@@ -131,8 +131,8 @@ BAD = {
         {"list.yaml": "- 1\n- 2\n"},
         [*RUN, "--scenario", "list.yaml"],
         "scenario list.yaml: [1, 2]; accepted: a mapping of robot, duration_s, plant, "
-        "simulator, human, advancement, standup, controller, controller_period_s, initial, "
-        "chair, seat_hold, fall, perturbation, visualization, log_period_s",
+        "simulator, human, advancement, standup, phases, controller, controller_period_s, "
+        "initial, chair, seat_hold, fall, perturbation, visualization, log_period_s",
     ),
     # 2. The chair file (chair.file).
     "chair_missing": (
@@ -293,9 +293,16 @@ BAD = {
         "{joints}",
     ),
     "unknown_posture_joint": (
+        {"posture.yaml": "phases:\n  lift_off:\n    posture_rad: {l_elbow: 0.3, elbow: 0.3}\n"},
+        [*RUN, "--scenario", "posture.yaml"],
+        "phases.lift_off.posture_rad: unknown joint(s) elbow; accepted: the joints of "
+        "iCubGazeboV2_5: {joints}",
+    ),
+    # An older file's key (config/legacy.py) is read into the phase table, which is named.
+    "unknown_posture_joint_older_key": (
         {"posture.yaml": "controller:\n  posture_state3_rad: {l_elbow: 0.3, elbow: 0.3}\n"},
         [*RUN, "--scenario", "posture.yaml"],
-        "controller.posture_state3_rad: unknown joint(s) elbow; accepted: the joints of "
+        "phases.lift_off.posture_rad: unknown joint(s) elbow; accepted: the joints of "
         "iCubGazeboV2_5: {joints}",
     ),
     "unknown_arm_weight_joint": (
@@ -567,5 +574,10 @@ def test_every_joint_table_names_a_key():
     names nothing (a typo, a renamed field) checks nothing; each names joints (a mapping
     or a list of names)."""
     tables = _joint_tables(Scenario())
-    assert len(tables) == len(JOINT_TABLES)
-    assert all(isinstance(table, dict | list) and table for _, table in tables)
+    for pattern in JOINT_TABLES:
+        regex = re.escape(pattern).replace(r"\[\*\]", r"\[\d+\]").replace(r"\*", r"[^.\[]*")
+        assert any(re.fullmatch(regex, key) for key, _ in tables), pattern
+    assert all(isinstance(table, dict | list) for _, table in tables)
+    # Empty only where a phase holds the posture it starts from (phases.py).
+    empty = [key for key, table in tables if not table]
+    assert empty == ["phases.seated.posture_rad"]

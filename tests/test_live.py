@@ -12,7 +12,6 @@ from pathlib import Path
 import msgpack
 import numpy as np
 import pytest
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
 from drake_standup.config import SCENARIO_DIR, HumanConfig, Scenario, load_scenario
 from drake_standup.diagram import build_diagram
@@ -27,9 +26,9 @@ from drake_standup.live import (
     LiveSession,
     gamepad_pull,
     make_live_meshcat,
+    run_session,
 )
-from drake_standup.scene import set_seated_state
-from drake_standup.simulate import simulate
+from drake_standup.runner import advance, prepare
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -49,32 +48,31 @@ def _set_pull(meshcat, left, right=None) -> None:
 
 
 class _Live:
-    """The live diagram of a scenario, stepped by hand (simulate()'s setup)."""
+    """A live run of a scenario (live.run_session's prepare), stepped by hand."""
 
     def __init__(self, scenario: Scenario):
         self.scenario = scenario
         self.meshcat = make_live_meshcat()
         self.session = LiveSession(scenario, self.meshcat, report=lambda line: None)
-        self.built = build_diagram(scenario, self.meshcat, make_human=self.session.make_human)
-        self.simulator = Simulator(self.built.diagram)
-        ApplySimulatorConfig(scenario.simulator, self.simulator)
-        self.root = self.simulator.get_mutable_context()
-        self.plant = self.built.scene.plant
+        self.run = prepare(
+            scenario, self.meshcat, make_human=self.session.make_human, live_transforms=True
+        )
+        self.session.started(self.run)
+        self.built = self.run.built
+        self.root = self.run.simulator.get_mutable_context()
+        self.plant = self.built.station.plant
         self.plant_context = self.plant.GetMyMutableContextFromRoot(self.root)
-        set_seated_state(self.built.scene, self.plant_context, scenario)
-        self.simulator.Initialize()
-        self.session.started(self.simulator, self.built)
         self.human = self.built.diagram.GetSubsystemByName("human")
         self.step = scenario.plant.time_step
 
     def advance(self, duration_s: float) -> bool:
-        """Simulates duration_s more, then what simulate() does after a chunk."""
-        self.simulator.AdvanceTo(self.root.get_time() + duration_s)
-        return self.session.after_chunk(self.simulator, self.built)
+        """Simulates duration_s more, then what the live run does after a chunk."""
+        advance(self.run, self.root.get_time() + duration_s)
+        return self.session.after_chunk(self.run)
 
     def applied(self) -> np.ndarray:
         """(2, 3) the forces on the hands' bodies in the plant's applied-force input."""
-        robot = self.built.scene.robot
+        robot = self.built.station.scene.robot
         bodies = [robot.frame(self.plant, h).body().index() for h in ("l_hand", "r_hand")]
         got = np.zeros((2, 3))
         for f in self.plant.get_applied_spatial_force_input_port().Eval(self.plant_context):
@@ -87,9 +85,12 @@ class _Live:
         port = self.human.GetOutputPort("hand_wrenches_W")
         return port.Eval(self.human.GetMyContextFromRoot(self.root)).reshape(2, 6)[:, 3:]
 
-    def output(self, system: str, port: str) -> np.ndarray:
-        s = self.built.diagram.GetSubsystemByName(system)
-        return s.GetOutputPort(port).Eval(s.GetMyContextFromRoot(self.root))
+    def output(self, name: str) -> np.ndarray:
+        """The run's diagram's output name (diagram.py)."""
+        return self.built.output(name, self.root)
+
+    def human_output(self, name: str) -> np.ndarray:
+        return self.human.GetOutputPort(name).Eval(self.human.GetMyContextFromRoot(self.root))
 
 
 def _world(pull) -> np.ndarray:
@@ -111,7 +112,11 @@ def test_live_human_has_the_scripted_humans_ports():
     built = build_diagram(scenario)
     scripted = built.diagram.GetSubsystemByName("human")
     live = LiveHumanSource(
-        built.scene.plant, built.scene.robot, HumanConfig(), make_live_meshcat(), 0.004
+        built.station.scene.plant,
+        built.station.scene.robot,
+        HumanConfig(),
+        make_live_meshcat(),
+        0.004,
     )
     for kind in ("input", "output"):
         count = getattr(scripted, f"num_{kind}_ports")()
@@ -185,10 +190,10 @@ def test_stand_up_button_starts_the_stand_up_and_reset_puts_the_robot_back():
     assert live.human.HasOutputPort("stand_up")
     q0 = live.plant.GetPositions(live.plant_context).copy()
     live.advance(0.4)
-    assert live.output("state_machine", "standup_state")[0] == 1
+    assert live.output("standup_state")[0] == 1
     _click(live.meshcat, STAND_UP)
     live.advance(0.1)
-    assert live.output("state_machine", "standup_state")[0] == 2
+    assert live.output("standup_state")[0] == 2
     live.advance(0.5)
     assert not np.allclose(live.plant.GetPositions(live.plant_context), q0, atol=1e-3)
 
@@ -196,12 +201,12 @@ def test_stand_up_button_starts_the_stand_up_and_reset_puts_the_robot_back():
     assert not live.advance(live.step)  # after_chunk sees the click and resets
     t_reset = live.root.get_time()
     np.testing.assert_array_equal(live.plant.GetPositions(live.plant_context), q0)
-    assert live.output("state_machine", "standup_state")[0] == 1
-    assert live.output("state_machine", "entry_times_s")[0] == t_reset
-    assert live.output("advancement", "psi")[0] == 0.0
-    assert live.output("human", "stand_up")[0] == 0.0
+    assert live.output("standup_state")[0] == 1
+    assert live.output("entry_times_s")[0] == t_reset
+    assert live.output("psi")[0] == 0.0
+    assert live.human_output("stand_up")[0] == 0.0
     live.advance(0.5)  # past the balance time again: the old click does not count
-    assert live.output("state_machine", "standup_state")[0] == 1
+    assert live.output("standup_state")[0] == 1
     assert live.root.get_time() > t_reset
 
     _click(live.meshcat, STOP)
@@ -216,8 +221,8 @@ class _Pulling(LiveSession):
         super().__init__(scenario, make_live_meshcat(), report=lambda line: None)
         self._pull = pull
 
-    def started(self, simulator, built, fall=None) -> None:
-        super().started(simulator, built, fall)
+    def started(self, run) -> None:
+        super().started(run)
         _set_pull(self.meshcat, self._pull)
 
 
@@ -235,7 +240,7 @@ def test_a_helpful_slider_pull_advances_psi_and_a_backward_one_does_not():
         scenario.duration_s = 2.5
         scenario.simulator.target_realtime_rate = 0.0  # as fast as it goes
         session = _Pulling(scenario, pull)
-        result = simulate(scenario, None, progress=False, live=session)
+        result = run_session(scenario, session)
         runs[name] = result.signals
         np.testing.assert_allclose(
             result.signals["hand_wrenches_W"][-1].reshape(2, 6)[:, 3:], [_world(pull)] * 2
@@ -258,12 +263,12 @@ class _Toppling(_Pulling):
         self._report = self.lines.append
         self.reset_at = None
 
-    def after_chunk(self, simulator, built) -> bool:
+    def after_chunk(self, run) -> bool:
         if self.fell is not None and self.reset_at is None:
             _set_pull(self.meshcat, (0.0, 0.0))
             _click(self.meshcat, RESET)
-            self.reset_at = simulator.get_context().get_time()
-        return super().after_chunk(simulator, built)
+            self.reset_at = run.time_s
+        return super().after_chunk(run)
 
 
 def _toppling_scenario(duration_s: float):
@@ -282,7 +287,7 @@ def test_a_live_run_goes_on_after_a_fall_and_reset_stands_the_robot_up_again():
     pulling, the robot stands up on its own (trigger time) and stands at the end."""
     scenario = _toppling_scenario(6.0)
     session = _Toppling(scenario)
-    result = simulate(scenario, None, progress=False, live=session)
+    result = run_session(scenario, session)
     assert [line for line in session.lines if line.startswith("fall:")] == session.lines[:1]
     assert session.reset_at is not None and session.reset_at < 2.0
     m = result.metrics
@@ -299,7 +304,7 @@ def test_a_fall_no_reset_undid_is_the_runs_failure_reason():
     session = _Pulling(scenario, (-3.0, 0.0))
     lines = []
     session._report = lines.append
-    result = simulate(scenario, None, progress=False, live=session)
+    result = run_session(scenario, session)
     assert result.metrics["sim_time_s"] == pytest.approx(2.0)
     assert result.metrics["failure_reason"].startswith("fall: root_link height")
     assert lines == [f"{result.metrics['failure_reason']}; Reset puts the robot back on the chair"]

@@ -35,13 +35,18 @@ def test_html_is_self_contained_and_holds_the_recording(seated_run):
     assert result.metrics["recording_bytes"] == len(html.encode())
 
 
-def test_dot_names_every_system():
-    scenario = load_scenario()
-    built = build_diagram(scenario)
-    dot = built.diagram.GetGraphvizString(max_depth=1)
+def test_dot_names_every_system(tmp_path):
+    """The exported DOT (two levels deep) names every system of the diagram and of its
+    two boxes, the station and the stand-up controller."""
+    from drake_standup.recording import export_diagram
+
+    built = build_diagram(load_scenario())
+    dot = export_diagram(built.diagram, tmp_path)[0].read_text()
     names = [s.get_name() for s in built.diagram.GetSystems()]
-    assert len(names) >= 6
+    for box in ("station", "standup_controller"):
+        names += [s.get_name() for s in built.diagram.GetSubsystemByName(box).GetSystems()]
+    assert len(names) >= 20
     for name in names:
-        assert name in dot, name
+        assert f"name={name}" in dot, name
     for expected in ("plant", "scene_graph", "contact_forces", "controller"):
         assert expected in names

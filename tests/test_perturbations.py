@@ -21,8 +21,8 @@ from pydrake.multibody.plant import (
     MultibodyPlantConfig,
 )
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
+from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource, PassThrough
 
 from drake_standup import perturbations
 from drake_standup.config import HumanConfig, InitialPose, Pull, Push, Scenario, ScenarioError
@@ -65,59 +65,61 @@ def _scenario(**perturbation) -> Scenario:
 
 # --- Defaults ------------------------------------------------------------------
 
-DEFAULT_SYSTEMS = {
-    "advancement",
-    "com_reference",
-    "contact_forces",
-    "seat_pad_forces",
-    "pads_vertical_force",
-    "controller",
-    "human",
-    "plant",
-    "scene_graph",
-    "sensing",
-    "state_machine",
-} | {
-    f"log_{name}"
+
+def _systems(diagram, prefix: str = "") -> dict[str, object]:
+    """Every system of diagram and of the diagrams inside it, by path (box/name)."""
+    found = {}
+    for system in diagram.GetSystems():
+        found[prefix + system.get_name()] = system
+        if isinstance(system, Diagram):
+            found |= _systems(system, f"{prefix}{system.get_name()}/")
+    return found
+
+
+DEFAULT_STATION = {
+    f"station/{name}"
     for name in (
-        "alpha",
-        "com_W",
-        "com_reference",
-        "controller_diagnostics",
-        "hand_wrenches_W",
-        "held_back",
-        "net_actuation",
-        "pad_forces_W",
-        "psi",
-        "psi_dot",
-        "robot_state",
-        "segment",
-        "standup_state",
+        "plant",
+        "scene_graph",
+        "contact_forces",
+        "seat_pad_normal_forces_N",
+        "pads_vertical_force_N",
+        "hand_wrench_sensor",
+        "sensing",
     )
 }
 
 
 def test_defaults_add_no_perturbation_system():
+    """The default station: the plant, the pads' forces and sensors, the hands' sensor a
+    pass-through; nothing pushes; no push force is logged."""
     built = build_diagram(Scenario())
-    assert {s.get_name() for s in built.diagram.GetSystems()} == DEFAULT_SYSTEMS
+    systems = _systems(built.diagram)
+    station = {name for name in systems if name.startswith("station/")}
+    assert station == DEFAULT_STATION
+    assert isinstance(systems["station/hand_wrench_sensor"], PassThrough)
     assert "push_force_W" not in built.logs
     # Every proximity geometry keeps its file's friction (all 1.0).
-    inspector = built.scene.scene_graph.model_inspector()
+    inspector = built.station.scene.scene_graph.model_inspector()
     for gid in inspector.GetAllGeometryIds(Role.kProximity):
         mu = inspector.GetProximityProperties(gid).GetProperty("material", "coulomb_friction")
         assert (mu.static_friction(), mu.dynamic_friction()) == (1.0, 1.0)
 
 
 def test_all_perturbations_add_their_systems_only():
+    """Pushes and sensor noise add the push source and the forces' multiplexer to the
+    station, the noisy hands' sensor in place of the pass-through, and the push force's
+    logger; nothing else changes."""
+    default = set(_systems(build_diagram(Scenario()).diagram))
     scenario = _scenario(pushes=PUSHES, hand_wrench_noise_N=1.0)
-    names = {s.get_name() for s in build_diagram(scenario).diagram.GetSystems()}
-    assert names - DEFAULT_SYSTEMS == {
-        "pushes",
-        "applied_forces",
-        "hand_wrench_sensor",
+    systems = _systems(build_diagram(scenario).diagram)
+    assert set(systems) - default == {
+        "station/pushes",
+        "station/applied_forces",
         "log_push_force_W",
     }
-    assert DEFAULT_SYSTEMS <= names
+    assert default <= set(systems)
+    assert isinstance(systems["station/hand_wrench_sensor"], NoisyWrenchSensor)
 
 
 # --- Pushes --------------------------------------------------------------------
@@ -143,7 +145,7 @@ def test_plant_gets_human_and_push_forces_and_sensors_only_the_human():
     scenario = _scenario(pushes=PUSHES)
     scenario.human = HumanConfig(pulls=[PULL])
     built = build_diagram(scenario)
-    plant, robot = built.scene.plant, built.scene.robot
+    plant, robot = built.station.plant, built.station.robot
     root = built.diagram.CreateDefaultContext()
     plant_context = plant.GetMyContextFromRoot(root)
     hand = robot.frame(plant, "r_hand")
@@ -151,8 +153,8 @@ def test_plant_gets_human_and_push_forces_and_sensors_only_the_human():
         plant.GetBodyByName(name, robot.model_instance).index(): name
         for name in ("chest", "l_upper_leg")
     }
-    human = built.diagram.GetSubsystemByName("human")
-    pushes = built.diagram.GetSubsystemByName("pushes")
+    systems = _systems(built.diagram)
+    human, pushes = systems["human"], systems["station/pushes"]
     windows_seen = set()
     for t in (0.1, 0.4999, 0.5, 0.55, 0.6, 0.65, 0.6999, 0.7, 0.8, 0.8999, 0.9, 1.5):
         root.SetTime(t)
@@ -179,7 +181,7 @@ def test_plant_gets_human_and_push_forces_and_sensors_only_the_human():
         # The wrist sensors measure the pull only.
         wrenches = human.GetOutputPort("hand_wrenches_W").Eval(human.GetMyContextFromRoot(root))
         np.testing.assert_array_equal(wrenches, [0, 0, 0, 0, 0, 0, 0, 0, 0, 7.0, 0, 3.0])
-        sensing = built.diagram.GetSubsystemByName("sensing")
+        sensing = systems["station/sensing"]
         measured = sensing.GetInputPort("hand_wrenches_W").Eval(sensing.GetMyContextFromRoot(root))
         np.testing.assert_array_equal(measured, wrenches)
     assert windows_seen == {(), ("chest",), ("chest", "l_upper_leg"), ("l_upper_leg",)}
@@ -349,14 +351,19 @@ def test_noise_reaches_every_consumer_but_not_the_plant():
     scenario = _scenario(hand_wrench_noise_N=3.0, noise_seed=5)
     scenario.human = HumanConfig(pulls=[PULL])
     built = build_diagram(scenario)
-    diagram, plant = built.diagram, built.scene.plant
+    diagram, plant = built.diagram, built.station.scene.plant
     root = diagram.CreateDefaultContext()
     root.SetTime(1.234)
     true = np.array([0, 0, 0, 0, 0, 0, 0, 0, 0, 7.0, 0, 3.0])
     expected = true.copy()
     expected[FORCES] += _spec_noise(5, 123, 3.0)
-    for name in ("sensing", "state_machine", "controller"):
-        system = diagram.GetSubsystemByName(name)
+    systems = _systems(diagram)
+    consumers = ["station/sensing"] + [
+        f"standup_controller/{name}"
+        for name in ("state_machine", "controller_model", "task_references")
+    ]
+    for name in consumers:
+        system = systems[name]
         got = system.GetInputPort("hand_wrenches_W").Eval(system.GetMyContextFromRoot(root))
         np.testing.assert_allclose(got, expected, atol=1e-12)
     logger = built.logs["hand_wrenches_W"]
@@ -374,16 +381,16 @@ def test_mass_scale_acts_on_the_simulated_plant_only():
     scenario = _scenario(mass_scale=s)
     scenario.human = HumanConfig(pulls=[PULL])
     built = build_diagram(scenario)
-    plant, robot = built.scene.plant, built.scene.robot
+    plant, robot = built.station.plant, built.station.robot
     instance = robot.model_instance
     root = built.diagram.CreateDefaultContext()
     root.SetTime(1.0)
     plant_context = plant.GetMyMutableContextFromRoot(root)
-    set_seated_state(built.scene, plant_context, scenario)
+    set_seated_state(built.station.scene, plant_context, scenario)
     nominal_context = plant.CreateDefaultContext()
     nominal = plant.CalcTotalMass(nominal_context, [instance])
-    apply_model_errors(built.scene, plant_context, scenario)
-    apply_model_errors(built.scene, plant_context, scenario)  # idempotent
+    apply_model_errors(built.station.scene, plant_context, scenario)
+    apply_model_errors(built.station.scene, plant_context, scenario)  # idempotent
     assert plant.CalcTotalMass(plant_context, [instance]) == pytest.approx(s * nominal, rel=1e-12)
     for index in plant.GetBodyIndices(instance):
         body = plant.get_body(index)
@@ -404,11 +411,12 @@ def test_mass_scale_acts_on_the_simulated_plant_only():
     np.testing.assert_allclose(plant.CalcMassMatrix(plant_context), s * M_nominal, rtol=1e-12)
 
     # The controller's terms, at the simulated state, use the nominal model.
-    terms = built.controller._kinematics.calc(x, ["l_sole"])
+    model = _systems(built.diagram)["standup_controller/controller_model"]
+    terms = model.kinematics.calc(x, ["l_sole"])
     assert terms.mass_kg == pytest.approx(nominal, rel=1e-12)
     np.testing.assert_allclose(terms.M, M_nominal, rtol=1e-12, atol=1e-12)
     # Sensing: Omega f of a pure force is that force over the nominal mass.
-    sensing = built.diagram.GetSubsystemByName("sensing")
+    sensing = _systems(built.diagram)["station/sensing"]
     omega_f = sensing.GetOutputPort("omega_f_W").Eval(sensing.GetMyContextFromRoot(root))
     np.testing.assert_allclose(omega_f, np.array(PULL.force_N) / nominal, rtol=1e-9)
 
@@ -421,8 +429,10 @@ def test_simulate_applies_the_mass_scale_and_reports_both_masses():
     metrics = simulate(scenario, None, record=False, progress=False).metrics
     nominal = Scenario()
     built = build_diagram(nominal)
-    instance = built.scene.robot.model_instance
-    mass = built.scene.plant.CalcTotalMass(built.scene.plant.CreateDefaultContext(), [instance])
+    instance = built.station.scene.robot.model_instance
+    mass = built.station.scene.plant.CalcTotalMass(
+        built.station.scene.plant.CreateDefaultContext(), [instance]
+    )
     assert metrics["robot_mass_kg"] == pytest.approx(mass, rel=1e-12)
     assert metrics["simulated_mass_kg"] == pytest.approx(1.05 * mass, rel=1e-12)
     assert metrics["weight_N"] == pytest.approx(1.05 * mass * 9.81, rel=1e-12)
@@ -465,8 +475,8 @@ def test_friction_scale_scales_every_surface_and_keeps_the_rest():
     """Each proximity geometry (robot pads, floor, chair) gets s times its
     friction; every other property and the collision filters stay."""
     s = 0.8
-    scaled = build_diagram(_scenario(friction_scale=s)).scene.scene_graph.model_inspector()
-    nominal = build_diagram(Scenario()).scene.scene_graph.model_inspector()
+    scaled = build_diagram(_scenario(friction_scale=s)).station.scene.scene_graph.model_inspector()
+    nominal = build_diagram(Scenario()).station.scene.scene_graph.model_inspector()
     props, ref = _proximity(scaled), _proximity(nominal)
     assert set(props) == set(ref)
     assert {"floor::floor_collision", "chair::seat_collision", "iCub::l_sole_pad"} <= set(props)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drake_standup.outputs import load_signals, write_signals
+from drake_standup.signals import load_signals, write_signals
 
 pytestmark = pytest.mark.slow
 

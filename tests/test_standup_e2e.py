@@ -7,8 +7,8 @@ import pytest
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
 from drake_standup.diagram import build_diagram
-from drake_standup.outputs import load_signals
 from drake_standup.scene import erect_com_height_m
+from drake_standup.signals import load_signals
 from drake_standup.simulate import simulate
 
 pytestmark = pytest.mark.slow
@@ -226,7 +226,7 @@ def test_it_ends_standing_erect(run, request):
     built = build_diagram(scenario)
     final = dict(zip(names, q, strict=True))
     assert sig["com_W"][-1, 2] == pytest.approx(
-        erect_com_height_m(built.scene, scenario, final), abs=0.005
+        erect_com_height_m(built.station.scene, scenario, final), abs=0.005
     )
 
 

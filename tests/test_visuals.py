@@ -42,7 +42,7 @@ def test_arrows_spheres_lamp_and_bars_show_the_pull_com_state_and_psi_dot():
     _click(live.meshcat, STAND_UP)  # state 2 from 0.2 s
     # To a publish time (every 40 ms) past the balance time and the pull's first step.
     live.advance(0.24)
-    m, plant, robot = live.meshcat, live.plant, live.built.scene.robot
+    m, plant, robot = live.meshcat, live.plant, live.built.station.robot
     hand = robot.frame(plant, "l_hand").CalcPoseInWorld(live.plant_context).translation()
     arrow = _transform(m, f"{PREFIX}/pull/left")
     np.testing.assert_allclose(arrow.translation(), hand, atol=1e-12)
@@ -56,14 +56,14 @@ def test_arrows_spheres_lamp_and_bars_show_the_pull_com_state_and_psi_dot():
     com = plant.CalcCenterOfMassPositionInWorld(live.plant_context, [robot.model_instance])
     side = np.array([0.0, COM_SIDE_OFFSET_M, 0.0])
     np.testing.assert_allclose(_transform(m, f"{PREFIX}/com").translation(), com + side)
-    x_d = live.output("com_reference", "x_d_W")
+    x_d = live.output("x_d_W")
     np.testing.assert_allclose(_transform(m, f"{PREFIX}/com_reference").translation(), x_d + side)
 
-    state = int(live.output("state_machine", "standup_state")[0])
+    state = int(live.output("standup_state")[0])
     assert state == 2
     for k in range(1, 5):
         assert _property(m, f"{PREFIX}/state/{k}", "visible") is (k == state)
-    psi_dot = live.output("advancement", "psi_dot")[0]
+    psi_dot = live.output("psi_dot")[0]
     assert _property(m, f"{PREFIX}/psi_dot/bar/scaled", "scale")[2] == PSI_DOT_M * psi_dot
 
 

@@ -61,6 +61,11 @@ class RobotTerms:
     # () -> (k, 3, 3): R_WF of frame_names, computed when called (a Drake call each).
     frame_rotations: partial
 
+    def __deepcopy__(self, memo: dict) -> "RobotTerms":
+        """Itself: the terms of one state, never changed once computed (Drake clones a
+        context's cached values, e.g. the live mode's Reset point)."""
+        return self
+
 
 class RobotKinematics:
     """Computes RobotTerms from the robot's state with a private plant context.
