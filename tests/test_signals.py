@@ -151,16 +151,15 @@ def test_the_psi_equals_t_run_in_its_own_process_equals_one_run_here(monkeypatch
     import sys
 
     from drake_standup.config import SCENARIO_DIR, load_scenario
-    from drake_standup.simulate import _Baseline
+    from drake_standup.baseline import Baseline
 
     scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
     scenario.duration_s = 0.8
-    scenario.advancement.enabled = False
     for pull in scenario.human.pulls:
         pull.start_s = 0.1
-    there = _Baseline(scenario, "whole_body", 0.05).result()
+    there = Baseline(scenario, "whole_body", 0.05).result()
     monkeypatch.setattr(sys, "executable", "/bin/false")
-    here = _Baseline(scenario, "whole_body", 0.05).result()
+    here = Baseline(scenario, "whole_body", 0.05).result()
     assert "simulating it here" in capsys.readouterr().err
     assert there.signals.keys() == here.signals.keys()
     for name in here.signals:

@@ -1,0 +1,165 @@
+"""The contact schedule (control/schedule.py): the bounds, the unloading memory and the
+seat's hold, from hand-computed cases; and the system's memory over ticks."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from pydrake.common.value import Value
+from pydrake.systems.analysis import Simulator
+
+from drake_standup.config import ControllerConfig
+from drake_standup.control.schedule import (
+    CONTACTS,
+    ContactScheduler,
+    contact_commands,
+    next_unload_from,
+    phase_seat_hold,
+)
+from drake_standup.phases import PhaseTable
+from drake_standup.state_machine import Measurements, _enter, _sit_back, initial_mode
+
+CONFIG = ControllerConfig()
+TABLE = PhaseTable()
+NAN3 = np.full(3, math.nan)
+F_MIN, SEAT_MAX, FOOT_MAX = 10.0, 400.0, 1000.0  # the defaults, N (SPEC 3, 7)
+MARGIN = 20.0  # controller.seat_measured_margin_N
+
+
+def _m(t: float) -> Measurements:
+    return Measurements(t, t, np.array([0.06, 0.0, 0.38]), 0.1, (0.0, 0.0), (0.0, 0.0))
+
+
+def test_the_defaults_are_the_documented_bounds():
+    assert (CONFIG.min_normal_force_N, CONFIG.seat_max_normal_force_N) == (F_MIN, SEAT_MAX)
+    assert (CONFIG.foot_max_normal_force_N, CONFIG.seat_measured_margin_N) == (FOOT_MAX, MARGIN)
+
+
+def test_seated_pads_get_the_seated_bounds_and_the_phase_hold():
+    commands = contact_commands(CONFIG, NAN3, np.zeros(3), None, "held")
+    assert commands.active == (True,) * 5
+    np.testing.assert_array_equal(commands.min_normal_force_N, [F_MIN] * 5)
+    np.testing.assert_array_equal(commands.max_normal_force_N, [SEAT_MAX] * 3 + [FOOT_MAX] * 2)
+    assert commands.seat_hold == "held"
+
+
+def test_a_releasing_pad_is_bounded_by_what_is_left_and_by_what_it_carries():
+    """The buttocks with half their load left, released from 120 N, carrying 30 N: at
+    most min(0.5 x 120, 30 + 20) = 50 N, at least 0; the seated thighs keep [10, 400];
+    the seat holds no rows once the buttocks release."""
+    loads = np.array([0.5, math.nan, math.nan])
+    commands = contact_commands(
+        CONFIG, loads, np.array([120.0, 80.0, 80.0]), np.array([30.0, 55.0, 55.0]), "hinged"
+    )
+    assert commands.min_normal_force_N[0] == 0.0 and commands.max_normal_force_N[0] == 50.0
+    np.testing.assert_array_equal(commands.min_normal_force_N[1:3], [F_MIN, F_MIN])
+    np.testing.assert_array_equal(commands.max_normal_force_N[1:3], [SEAT_MAX, SEAT_MAX])
+    assert commands.seat_hold == "free"
+    # Measured above what is left: the fraction binds (0.25 x 80 = 20 < 55 + 20).
+    loads = np.array([0.0, 0.25, 0.25])
+    commands = contact_commands(
+        CONFIG, loads, np.array([120.0, 80.0, 80.0]), np.array([0.0, 55.0, 55.0]), "hinged"
+    )
+    np.testing.assert_array_equal(commands.max_normal_force_N[:3], [0.0, 20.0, 20.0])
+    np.testing.assert_array_equal(commands.min_normal_force_N[:3], 0.0)
+    # A negative measurement (a pad pulled off) counts as 0: margin only.
+    commands = contact_commands(
+        CONFIG, np.array([1.0, math.nan, math.nan]), np.array([200.0, 0, 0]), -np.ones(3), "held"
+    )
+    assert commands.max_normal_force_N[0] == MARGIN
+
+
+def test_the_chair_leaves_the_qp_once_every_seat_pad_is_released():
+    for loads, active in (([0.0, 0.0, 0.0], False), ([0.0, 1e-6, 1e-6], True)):
+        commands = contact_commands(CONFIG, np.array(loads), np.ones(3), None, "hinged")
+        assert commands.active == (active,) * 3 + (True, True)
+        np.testing.assert_array_equal(commands.min_normal_force_N[3:], F_MIN)
+
+
+def test_the_release_starts_from_the_last_commanded_load():
+    """A seated pad, or one at the first ticks of its release (what is left >= 1),
+    follows the last commanded load; a releasing pad keeps the load it started from."""
+    last = np.array([100.0, 60.0, 61.0])
+    before = np.array([90.0, 50.0, 51.0])
+    got = next_unload_from(before, last, np.array([math.nan, 1.0, 0.4]))
+    np.testing.assert_array_equal(got, [100.0, 60.0, 51.0])
+
+
+def test_the_seat_hold_is_the_phases_and_after_a_sit_back_its_other():
+    seated = initial_mode(np.zeros(3))
+    assert phase_seat_hold(seated, TABLE) == TABLE.seated.seat_hold == "held"
+    forward = _enter(seated, 2, _m(3.0), TABLE)
+    assert phase_seat_hold(forward, TABLE) == "hinged"
+    back = _sit_back(forward, _m(3.5), TABLE)
+    assert back.state == 1 and back.sat_back
+    assert phase_seat_hold(back, TABLE) == TABLE.seated.seat_hold_sat_back == "hinged"
+
+
+# A period of 2^-7 s: its ticks' times are exact in binary, so a tick's time is never a
+# rounding error away from the time the test asks for.
+PERIOD_S = 2.0**-7
+
+
+class _Schedule:
+    """The ContactScheduler alone, its inputs fixed by hand."""
+
+    def __init__(self):
+        self.system = ContactScheduler(CONFIG, TABLE, period_s=PERIOD_S)
+        self.context = self.system.CreateDefaultContext()
+        self.simulator = Simulator(self.system, self.context)
+        self.system.GetInputPort("seat_pad_normal_forces_N").FixValue(self.context, [1e3] * 3)
+        self.system.GetInputPort("mode").FixValue(
+            self.context, Value[object](initial_mode(np.zeros(3)))
+        )
+        self.system.GetInputPort("commanded_normal_forces_N").FixValue(self.context, np.zeros(5))
+        self.simulator.Initialize()
+
+    def tick(self, t: float, mode, commanded) -> object:
+        """The commands of the tick at t (what the controller reads then) with mode and
+        commanded as inputs, and that tick's update (Drake handles an event at t at the
+        start of the step after t)."""
+        self.system.GetInputPort("mode").FixValue(self.context, Value[object](mode))
+        self.system.GetInputPort("commanded_normal_forces_N").FixValue(self.context, commanded)
+        self.simulator.AdvanceTo(t)
+        commands = self.system.GetOutputPort("contact_commands").Eval(self.context)
+        self.simulator.AdvanceTo(t + 1e-9)
+        return commands
+
+
+def test_the_scheduler_remembers_the_load_the_release_began_from():
+    """Seated, the controller asks 100 N of the buttocks, also at the first tick of state
+    2 (entered at 1 s); from there the buttocks' bound falls from those 100 N along the
+    smoothstep over unload_s, whatever the controller asks later, and a failed tick
+    (NaN) changes nothing."""
+    schedule = _Schedule()
+    seated = initial_mode(np.zeros(3))
+    asked = np.array([100.0, 70.0, 70.0, 60.0, 60.0])
+    for k in range(1, 128):
+        commands = schedule.tick(k * PERIOD_S, seated, asked)
+    assert commands.max_normal_force_N[0] == SEAT_MAX
+    forward = _enter(seated, 2, _m(1.0), TABLE)
+    over = TABLE.forward.unload_s
+    for k in range(int(over / PERIOD_S)):
+        t = 1.0 + k * PERIOD_S
+        later = asked * (1.0 if k == 0 else 0.5 if k % 2 else 1.5)
+        if k == 3:
+            later[:] = np.nan
+        commands = schedule.tick(t, forward, later)
+        r = 1.0 - (t - 1.0) / over
+        left = r * r * (3.0 - 2.0 * r)
+        assert commands.max_normal_force_N[0] == pytest.approx(100.0 * left, abs=1e-9), t
+    assert commands.min_normal_force_N[0] == 0.0
+
+
+def test_a_failed_tick_keeps_the_last_successful_commands():
+    schedule = _Schedule()
+    seated = initial_mode(np.zeros(3))
+    schedule.tick(4 * PERIOD_S, seated, np.array([80.0, 70.0, 70.0, 60.0, 60.0]))
+    schedule.tick(8 * PERIOD_S, seated, np.full(5, np.nan))  # the QP failed meanwhile
+    forward = _enter(seated, 2, _m(8 * PERIOD_S), TABLE)
+    commands = schedule.tick(9 * PERIOD_S, forward, np.full(5, np.nan))
+    left = 1.0 - PERIOD_S / TABLE.forward.unload_s
+    assert commands.max_normal_force_N[0] == pytest.approx(80.0 * left * left * (3 - 2 * left))
+    assert len(commands.active) == len(CONTACTS)

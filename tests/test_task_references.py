@@ -1,0 +1,238 @@
+"""The task references (control/references.py) from the phase table, against values
+computed here from Drake's CoM, momentum and joint limits: gains, posture targets, the
+centroidal momentum target, the help let through, the stance, the lean, the base target,
+and the generator's memory over ticks."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from pydrake.common.value import Value
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from drake_standup.config import ControllerConfig, Scenario
+from drake_standup.config.inputs import TASK_FRAMES
+from drake_standup.control.model import HANDS, ControllerJoints
+from drake_standup.control.qp import as_slice
+from drake_standup.control.references import (
+    ReferenceGenerator,
+    StandupSchedule,
+    TaskReferenceGenerator,
+    static_lean,
+)
+from drake_standup.control.terms import RobotKinematics
+from drake_standup.phases import PHASES, PhaseTable
+from drake_standup.scene import add_scene, set_seated_state
+
+T = 0.004
+CONFIG = ControllerConfig()
+TABLE = PhaseTable()
+
+
+@pytest.fixture(scope="module")
+def rig():
+    scenario = Scenario()
+    scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
+    plant, robot = scene.plant, scene.robot
+    context = plant.CreateDefaultContext()
+    set_seated_state(scene, context, scenario)
+    instance = robot.model_instance
+    rng = np.random.default_rng(4)
+    plant.SetVelocities(context, instance, rng.normal(scale=0.2, size=plant.num_velocities()))
+    x = plant.GetPositionsAndVelocities(context, instance)
+    joints = ControllerJoints.of(plant, robot)
+    schedule = StandupSchedule(TABLE, CONFIG, joints.names, joints.q_min, joints.q_max)
+    g = -plant.gravity_field().gravity_vector()[2]
+    generator = ReferenceGenerator(CONFIG, schedule, as_slice(joints.q_indices), T, g)
+    kinematics = RobotKinematics(plant, robot, held_frames=[], other_frames=list(HANDS))
+    return {
+        "plant": plant,
+        "instance": instance,
+        "context": context,
+        "x": x,
+        "joints": joints,
+        "schedule": schedule,
+        "generator": generator,
+        "kinematics": kinematics,
+        "g": g,
+    }
+
+
+def _drake_com(rig):
+    plant, context, instance = rig["plant"], rig["context"], rig["instance"]
+    p = plant.CalcCenterOfMassPositionInWorld(context, [instance])
+    v = plant.CalcCenterOfMassTranslationalVelocityInWorld(context, [instance])
+    L = plant.CalcSpatialMomentumInWorldAboutPoint(context, [instance], p).rotational()
+    return p, v, L, plant.CalcTotalMass(context, [instance])
+
+
+def test_the_schedule_is_the_phase_tables(rig):
+    """Per state: K_P as the table says, K_D = 2 zeta sqrt(K_P); the posture target the
+    table's joints, clamped posture_limit_margin_rad inside Drake's joint limits; the
+    joints a phase does not name hold."""
+    plant, instance, schedule = rig["plant"], rig["instance"], rig["schedule"]
+    margin = CONFIG.posture_limit_margin_rad
+    for state, name in enumerate(PHASES, start=1):
+        phase, ref = getattr(TABLE, name), schedule[state]
+        np.testing.assert_array_equal(ref.com_kp_per_s2, phase.com_kp_per_s2)
+        kd = [2.0 * CONFIG.com_damping_ratio * math.sqrt(kp) for kp in phase.com_kp_per_s2]
+        np.testing.assert_allclose(ref.com_kd_per_s, kd, rtol=1e-15)
+        assert ref.base_pitch_rad == phase.base_pitch_rad
+        assert (ref.lean, ref.stance) == (phase.lean, phase.stance)
+        for k, joint in enumerate(rig["joints"].names):
+            if joint not in phase.posture_rad:
+                assert ref.posture_hold[k]
+                continue
+            limits = plant.GetJointByName(joint, instance)
+            low = limits.position_lower_limits()[0] + margin
+            high = limits.position_upper_limits()[0] - margin
+            assert not ref.posture_hold[k]
+            assert ref.posture_rad[k] == min(max(phase.posture_rad[joint], low), high)
+    # SPEC 3's elbow target 0.2473 rad lies below the URDF's 0.262 limit: clamped.
+    k = rig["joints"].names.index("l_elbow")
+    assert schedule[2].posture_rad[k] > TABLE.forward.posture_rad["l_elbow"]
+
+
+def _calc(rig, state, *, reference=None, hands=None, integral=None, progress=1.0, lean=None):
+    terms = rig["kinematics"].calc(rig["x"], [], HANDS if hands is not None else ())
+    nu = len(rig["joints"].names)
+    p, v, _, _ = _drake_com(rig)
+    if reference is None:
+        reference = np.concatenate([p + [0.02, 0.0, -0.01], [0.1, 0.0, 0.05], [0.3, 0.0, 0.1]])
+    return rig["generator"].calc(
+        terms,
+        state,
+        reference,
+        hands,
+        np.zeros(3) if integral is None else integral,
+        np.zeros(2 + 2 * nu),
+        lean,
+        progress,
+        0.0,
+    ), reference
+
+
+def test_the_momentum_target_is_the_com_law_and_the_angular_damping(rig):
+    """State 2, no pull: Ldot* = [-K_D,ang L - K_P,ang int L; m (xd_ddot - K_D (v - xd_dot)
+    - K_P (x - x_d))], with Drake's CoM, its velocity and the angular momentum."""
+    integral = np.array([0.01, -0.02, 0.03])
+    references, ref = _calc(rig, 2, integral=integral)
+    p, v, L, m = _drake_com(rig)
+    kp = np.array(TABLE.forward.com_kp_per_s2)
+    kd = 2.0 * np.sqrt(kp)
+    xddot = ref[6:9] - kd * (v - ref[3:6]) - kp * (p - ref[:3])
+    np.testing.assert_allclose(references.Ldot_star[3:], m * xddot, rtol=1e-9, atol=1e-9)
+    angular = -CONFIG.angular_momentum_kd_per_s * L - CONFIG.angular_momentum_kp_per_s2 * integral
+    np.testing.assert_allclose(references.Ldot_star[:3], angular, atol=1e-9)
+    assert references.tau_hand is None and not references.helpful_force_W.any()
+    np.testing.assert_allclose(references.next_momentum_integral, integral + T * L, atol=1e-12)
+
+
+def test_the_help_let_through_is_the_pull_along_the_desired_velocity(rig):
+    """State 2, the reference moving forward at 0.1 m/s (5x the fade speed), the CoM on
+    it: a 15 N forward + 15 N up pull per hand lets its 30 N forward part through into
+    the linear momentum target, and its hands' generalized force is J_h^T F."""
+    p, _, _, _ = _drake_com(rig)
+    reference = np.concatenate([p, [0.1, 0.0, 0.0], np.zeros(3)])
+    hands = np.tile([0.0, 0.0, 0.0, 15.0, 0.0, 15.0], 2)
+    pulled, _ = _calc(rig, 2, reference=reference, hands=hands)
+    alone, _ = _calc(rig, 2, reference=reference)
+    np.testing.assert_allclose(pulled.helpful_force_W, [30.0, 0.0, 0.0], atol=1e-9)
+    np.testing.assert_allclose(pulled.Ldot_star[3:] - alone.Ldot_star[3:], [30.0, 0, 0])
+    terms = rig["kinematics"].calc(rig["x"], [], HANDS)
+    J = np.concatenate([terms.J_W[0], terms.J_W[1]])
+    np.testing.assert_allclose(pulled.tau_hand, J.T @ hands, atol=1e-12)
+
+
+def test_the_stance_hands_the_height_to_the_legs(rig):
+    """State 4 at 85 % of the rise (stance_from_progress 0.7): the stance factor is the
+    smoothstep of (0.85 - 0.7) / 0.3 = 0.5, i.e. 0.5; the vertical row keeps 1 - 0.5 (1 -
+    0.1); the height integral grows by T 0.5 (z_d - z) and adds m K_I of it to the
+    vertical momentum target; no help passes."""
+    p, _, _, m = _drake_com(rig)
+    reference = np.concatenate([p + [0.0, 0.0, 0.05], np.zeros(6)])
+    hands = np.tile([0.0, 0.0, 0.0, 5.0, 0.0, 0.0], 2)
+    references, _ = _calc(rig, 4, reference=reference, hands=hands, progress=0.85)
+    assert references.stance == pytest.approx(0.5, rel=1e-12)
+    assert references.vertical_weight_scale == pytest.approx(1.0 - 0.5 * 0.9, rel=1e-12)
+    assert references.next_height_integral == pytest.approx(T * 0.5 * 0.05, rel=1e-6)
+    without, _ = _calc(rig, 4, reference=reference, hands=hands, progress=0.7)
+    assert without.stance == 0.0 and without.next_height_integral == 0.0
+    assert not references.helpful_force_W.any()
+    ki = CONFIG.stance_height_ki_per_s3
+    vertical = references.Ldot_star[5] - without.Ldot_star[5]
+    assert vertical == pytest.approx(m * ki * references.next_height_integral, rel=1e-9)
+
+
+def test_the_lean_moves_toward_the_static_lean_in_the_phases_that_lean(rig):
+    """A 10 N backward pull per hand: in state 3 (lean) the lean takes one filter step
+    toward static_lean of the hands' wrench about the CoM (T / tau of the way); in state
+    2 (no lean) it stays zero."""
+    hands = np.tile([0.0, 0.0, 0.0, -10.0, 0.0, 0.0], 2)
+    plant, context = rig["plant"], rig["context"]
+    p, _, _, m = _drake_com(rig)
+    wrench = np.zeros(6)
+    for k, hand in enumerate(HANDS):
+        frame = plant.GetFrameByName(TASK_FRAMES[hand], rig["instance"])
+        p_hand = frame.CalcPoseInWorld(context).translation()
+        f = hands[6 * k + 3 : 6 * k + 6]
+        wrench[:3] += np.cross(p_hand - p, f)
+        wrench[3:] += f
+    target = static_lean(wrench, p[2], m * rig["g"], CONFIG.lean_max_m)
+    target[0] = min(max(target[0], -CONFIG.lean_max_back_m), CONFIG.lean_max_forward_m)
+    leaning, _ = _calc(rig, 3, hands=hands)
+    blend = T / CONFIG.lean_filter_time_constant_s
+    np.testing.assert_allclose(leaning.lean_W, blend * target, atol=1e-12)
+    assert leaning.lean_W[0] > 0.0  # pulled back: the CoM target leans forward
+    upright, _ = _calc(rig, 2, hands=hands)
+    assert not upright.lean_W.any()
+
+
+def test_the_posture_and_the_base_target_at_the_first_tick(rig):
+    """The first tick latches the posture it starts from; the reference then moves T /
+    tau toward the phase's targets (held joints toward where they are); the base target
+    is upright at the current yaw, pitched forward by the phase's base pitch: the base's
+    up axis tilts toward where the robot faces by that angle."""
+    references, _ = _calc(rig, 2)
+    joints, schedule = rig["joints"], rig["schedule"]
+    q = rig["x"][joints.q_indices]
+    state = schedule[2]
+    clamped = np.clip(q, schedule.q_target_min, schedule.q_target_max)
+    target = np.where(state.posture_hold, clamped, state.posture_rad)
+    blend = T / CONFIG.posture_filter_time_constant_s
+    nu = len(q)
+    np.testing.assert_allclose(references.q_reference, q, atol=0.0)
+    np.testing.assert_allclose(
+        references.next_posture[1 + nu : 1 + 2 * nu], q + blend * (target - q), atol=1e-12
+    )
+    R_target = references.R_WB_target
+    R_WB = rig["kinematics"].calc(rig["x"], []).R_WB
+    facing = -R_WB[:, 0]  # root_link's x axis points backwards
+    facing[2] = 0.0
+    facing /= np.linalg.norm(facing)
+    up = R_target[:, 2]
+    assert up @ facing == pytest.approx(math.sin(TABLE.forward.base_pitch_rad), abs=1e-12)
+    assert up[2] == pytest.approx(math.cos(TABLE.forward.base_pitch_rad), abs=1e-12)
+
+
+def test_the_generator_integrates_the_angular_momentum_over_its_ticks(rig):
+    """The system, its inputs fixed: after the initialization tick and ticks at 0, T and
+    2 T, int L dt = 4 T L (Drake's angular momentum), and its lean output is the lean
+    state the last tick left."""
+    system = TaskReferenceGenerator(rig["generator"], T)
+    context = system.CreateDefaultContext()
+    terms = rig["kinematics"].calc(rig["x"], [])
+    p, _, L, _ = _drake_com(rig)
+    system.GetInputPort("terms").FixValue(context, Value[object](terms))
+    system.GetInputPort("standup_state").FixValue(context, [2.0])
+    system.GetInputPort("com_reference").FixValue(context, np.concatenate([p, np.zeros(6)]))
+    system.GetInputPort("hand_wrenches_W").FixValue(context, np.zeros(12))
+    system.GetInputPort("path_progress").FixValue(context, [0.0])
+    simulator = Simulator(system, context)
+    simulator.AdvanceTo(2.5 * T)
+    integral = context.get_discrete_state(0).value()
+    np.testing.assert_allclose(integral, 4 * T * L, atol=1e-12)
+    np.testing.assert_array_equal(system.GetOutputPort("lean_W").Eval(context), np.zeros(3))
