@@ -150,8 +150,8 @@ def test_the_psi_equals_t_run_in_its_own_process_equals_one_run_here(monkeypatch
     nothing of the scenario."""
     import sys
 
-    from drake_standup.config import SCENARIO_DIR, load_scenario
     from drake_standup.baseline import Baseline
+    from drake_standup.config import SCENARIO_DIR, load_scenario
 
     scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
     scenario.duration_s = 0.8
