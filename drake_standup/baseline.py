@@ -24,8 +24,9 @@ from pathlib import Path
 from pydrake.common.yaml import yaml_dump_typed
 
 from drake_standup.config import Scenario, parse_scenario
+from drake_standup.diagram import on_step_grid
 from drake_standup.records import write_metrics
-from drake_standup.runner import RunResult, advance, collect, finished, on_plant_grid, prepare
+from drake_standup.runner import RunResult, advance, collect, finished, prepare
 from drake_standup.signals import load_signals, write_signals
 
 
@@ -39,7 +40,7 @@ def needs_baseline(scenario: Scenario) -> bool:
 def simulate_quietly(scenario: Scenario, controller: str, chunk_s: float) -> RunResult:
     """A run to its end with no recording, no progress and no files."""
     run = prepare(scenario, None, controller=controller)
-    chunk_s = on_plant_grid(chunk_s, scenario)
+    chunk_s = on_step_grid(chunk_s, scenario.plant.time_step)
     chunk = 0
     while not finished(run):
         chunk += 1

@@ -188,12 +188,10 @@ def _add_visuals(
 
 
 def on_step_grid(period_s: float, step_s: float) -> float:
-    """period_s rounded to a whole number (>= 1) of plant steps (step_s 0: a
-    continuous plant, unchanged). A visualizer that publishes between the
-    plant's steps splits an integrator step of psi, so a recording would
-    change the simulation it records."""
-    if step_s <= 0.0:
-        return period_s
+    """period_s rounded to a whole number (>= 1) of plant steps (step_s > 0: a discrete
+    plant, config.validate). A publish between the plant's steps splits an integrator
+    step of psi, so a recording would change the simulation it records; a run's chunk
+    end a rounding error off an event time makes the integrator take a ~1e-17 s step."""
     return step_s * max(1, round(period_s / step_s))
 
 

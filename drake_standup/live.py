@@ -42,10 +42,11 @@ from pydrake.systems.framework import (
 )
 
 from drake_standup.config import HumanConfig, Scenario
+from drake_standup.diagram import on_step_grid
 from drake_standup.human import hand_forces, spatial_forces
 from drake_standup.outputs import write_run
 from drake_standup.robot import Robot
-from drake_standup.runner import Run, RunResult, advance, collect, finished, on_plant_grid, prepare
+from drake_standup.runner import Run, RunResult, advance, collect, finished, prepare
 
 # The page's controls, in the order they appear.
 HANDS = ("left", "right")
@@ -229,7 +230,7 @@ class LiveSession:
     def make_human(
         self, plant: MultibodyPlant, robot: Robot, config: HumanConfig
     ) -> LiveHumanSource:
-        step = self._scenario.plant.time_step or self._scenario.controller_period_s
+        step = self._scenario.plant.time_step
         self.human = LiveHumanSource(
             plant,
             robot,
@@ -330,7 +331,7 @@ def run_session(
     nobody knows the pull in advance)."""
     run = prepare(scenario, session.meshcat, make_human=session.make_human, live_transforms=True)
     session.started(run)
-    chunk_s = on_plant_grid(chunk_s, scenario)
+    chunk_s = on_step_grid(chunk_s, scenario.plant.time_step)
     chunk = 0
     while not finished(run):
         chunk += 1

@@ -171,13 +171,6 @@ def prepare(
     return Run(scenario, built, simulator, fall, meshcat, build_time_s)
 
 
-def on_plant_grid(period_s: float, scenario: Scenario) -> float:
-    """period_s as a whole number (>= 1) of plant steps: a chunk end a rounding error off
-    an event time makes the integrator take a ~1e-17 s step (8 % more steps at 5 ms)."""
-    step_s = scenario.plant.time_step
-    return step_s * max(1, round(period_s / step_s)) if step_s > 0.0 else period_s
-
-
 def advance(run: Run, t: float) -> bool:
     """Simulates to t (at most the scenario's duration); False once the run has ended: a
     fall, the QP failing for too long (the fall monitor) or the simulator throwing, the

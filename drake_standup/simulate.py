@@ -11,6 +11,7 @@ from pathlib import Path
 
 from drake_standup.baseline import Baseline, needs_baseline
 from drake_standup.config import Scenario
+from drake_standup.diagram import on_step_grid
 from drake_standup.outputs import write_run
 from drake_standup.progress import ProgressBar
 from drake_standup.runner import (
@@ -19,7 +20,6 @@ from drake_standup.runner import (
     collect,
     finished,
     make_meshcat,
-    on_plant_grid,
     prepare,
 )
 
@@ -50,7 +50,7 @@ def simulate(
     try:
         run = prepare(scenario, make_meshcat() if record else None, controller=controller)
         bar = ProgressBar(scenario.duration_s, "simulating") if progress else None
-        chunk_s = on_plant_grid(chunk_s, scenario)
+        chunk_s = on_step_grid(chunk_s, scenario.plant.time_step)
         chunk = 0
         while not finished(run):
             chunk += 1

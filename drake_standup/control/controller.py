@@ -202,6 +202,8 @@ class WholeBodyController(LeafSystem):
             specs, active, plant, joints, config, stance, torque_limit
         )
         self._programs: dict[tuple[bool, ...], Program] = {}
+        # The last contact commands and the program's form of them.
+        self._last: tuple[ContactCommands | None, QpContactCommands | None] = (None, None)
         self._timing: list[tuple[float, ...]] = []
         self._terms = self.DeclareAbstractInputPort("terms", Value[object](None))
         self._references = self.DeclareAbstractInputPort("task_references", Value[object](None))
@@ -245,15 +247,16 @@ class WholeBodyController(LeafSystem):
         t_inputs = time.perf_counter()
         program = self.program(commands.active)
         index = program.contact_index
-        solution = program.qp.solve(
-            terms,
-            references,
-            QpContactCommands(
-                commands.min_normal_force_N[index],
-                commands.max_normal_force_N[index],
-                program.partially_held[commands.seat_hold],
-            ),
-        )
+        if commands is not self._last[0]:  # the schedule's constant commands repeat
+            self._last = (
+                commands,
+                QpContactCommands(
+                    commands.min_normal_force_N[index],
+                    commands.max_normal_force_N[index],
+                    program.partially_held[commands.seat_hold],
+                ),
+            )
+        solution = program.qp.solve(terms, references, self._last[1])
         normal_forces_N = np.zeros(len(CONTACTS))
         normal_forces_N[index] = solution.F_C[:, NORMAL]
         return ControllerTick(

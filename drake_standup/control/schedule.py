@@ -20,6 +20,7 @@ the seat holds no rows once the buttocks release: docs/design.md, "Contacts".
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -111,6 +112,14 @@ class ContactScheduler(LeafSystem):
         self._config = config
         self._table = table
         self._releases = seat_releases(table)
+        # The commands while every seat pad is seated, by hold, and once every one is
+        # released: constant, so computed once (most ticks are in one or the other).
+        seated = np.full(3, np.nan)
+        self._seated = {
+            hold: contact_commands(config, seated, seated, None, hold) for hold in HOLDS
+        }
+        self._released = contact_commands(config, np.zeros(3), np.zeros(3), None, "free")
+        self._first_release = min((state for state, _, _ in self._releases), default=math.inf)
         self._mode = self.DeclareAbstractInputPort("mode", Value[object](StandupMode()))
         self._measured = self.DeclareVectorInputPort("seat_pad_normal_forces_N", 3)
         self._commanded = self.DeclareVectorInputPort("commanded_normal_forces_N", len(CONTACTS))
@@ -142,7 +151,11 @@ class ContactScheduler(LeafSystem):
         mode = self._mode.Eval(context)
         commanded = self._commanded.Eval(context)[CHAIR]
         last = commanded if np.isfinite(commanded).all() else memory[3:]
+        if mode.state < self._first_release:  # every pad seated: following its commands
+            return self._seated[phase_seat_hold(mode, self._table)], np.concatenate((last, last))
         loads = seat_loads(mode, context.get_time(), self._releases)
+        if not loads.any():  # every pad released (NaN, seated, counts as nonzero)
+            return self._released, np.concatenate((memory[:3], last))
         unload_from = next_unload_from(memory[:3], last, loads)
         measured = self._measured.Eval(context)
         commands = contact_commands(
