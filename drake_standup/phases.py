@@ -14,7 +14,9 @@ posture, base orientation, lean, stance).
 
     leaves when (Guard, all of them, and no hindering pull for standup.resume_after_s):
     1 -> 2   3 s balanced, the stand-up asked for (standup.trigger)
-    2 -> 3   segment done, the feet carry > 150 N together, the CoM 3 cm ahead of the heels
+    2 -> 3   segment done, the buttocks unloaded (their release waits for the CoM 1.5 cm
+             ahead of the thigh pads), the feet carry > 150 N together, the CoM 3 cm
+             ahead of the heels
     3 -> 4   the thighs unloaded, segment done, each foot carries > 95 N
     a pull against the stand-up: 1 waits, 2 sits back, 3 steps back, 4 stands (leans)
 
@@ -61,7 +63,8 @@ class Guard:
     # The phase's CoM segment is done: psi past its end (a segment that does not move is
     # done at once). It keeps the reference's slope continuous across the switch.
     segment_done: bool = True
-    # The pads this phase unloads have finished unloading (unload_s after entry).
+    # The pads this phase unloads have finished unloading (unload_s after their release
+    # began: at entry, or once unload_when holds).
     unloaded: bool = False
     # Both soles together carry more than this (filtered, Schmitt trigger). N.
     feet_force_N: float | None = None
@@ -101,6 +104,10 @@ class Phase:
     # unload_s (smoothstep); released pads stay so in the later phases. s.
     unload: list[str] = field(default_factory=list)
     unload_s: float = 0.0
+    # The release begins once the CoM is at least this far in front of the thigh pads'
+    # centres (the seat's support line: released behind it, the robot tips back onto
+    # the chair, docs/design.md "Leaving the seat for its reason"); None: at entry. m.
+    unload_when: float | None = None
     # The CoM target leans against the hands' pull (the feet alone carry the robot).
     lean: bool = False
     # The legs' posture, not the CoM height, ends the segment (controller.stance_*).
@@ -139,8 +146,9 @@ class PhaseTable:
             seat_hold="hinged",
             unload=["buttocks"],
             unload_s=0.2,
+            unload_when=0.015,
             when_hindered="sit_back",
-            exit=Guard(feet_force_N=150.0, com_ahead_of_heels_m=0.03),
+            exit=Guard(unloaded=True, feet_force_N=150.0, com_ahead_of_heels_m=0.03),
         )
     )
     # 3: the CoM further forward (SPEC 3), its height stiffened from where it is; the

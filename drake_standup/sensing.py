@@ -25,12 +25,23 @@ def heel_points(robot: Robot) -> dict[str, np.ndarray]:
     return points
 
 
+def thigh_points(robot: Robot) -> dict[str, np.ndarray]:
+    """Thigh frame -> the centre of its pad's bottom face, in that frame."""
+    points = {}
+    for shape in robot.contact_shapes:
+        if shape.group == "thigh" and shape.shape == "box":
+            x, y, z = shape.xyz_m
+            points[shape.frame] = np.array([x, y, z - shape.size_m[2] / 2])
+    return points
+
+
 class RobotSensing(LeafSystem):
     """Inputs robot_state [q; v], hand_wrenches_W (12: [tau_l, f_l, tau_r, f_r]).
 
-    Outputs com_W (3, m), com_velocity_W (3, m/s), omega_f_W (3, m/s^2) and
+    Outputs com_W (3, m), com_velocity_W (3, m/s), omega_f_W (3, m/s^2),
     heel_x_W (1, m: the front-most of the two soles' heel edges, so "CoM ahead
-    of the heels" holds for both feet).
+    of the heels" holds for both feet) and thigh_x_W (1, m: the mean x of the
+    thigh pads' centres, where the seat's support ends; NaN without pads).
 
     The CoM outputs share one cache entry that depends on robot_state only:
     the plant context is set once per new state (once per plant step), not
@@ -38,7 +49,13 @@ class RobotSensing(LeafSystem):
     machine reads it, at its own (slower) rate.
     """
 
-    def __init__(self, plant: MultibodyPlant, robot: Robot, heel_points: dict[str, np.ndarray]):
+    def __init__(
+        self,
+        plant: MultibodyPlant,
+        robot: Robot,
+        heel_points: dict[str, np.ndarray],
+        thigh_points: dict[str, np.ndarray] | None = None,
+    ):
         super().__init__()
         self._plant = plant
         self._instance = robot.model_instance
@@ -46,6 +63,10 @@ class RobotSensing(LeafSystem):
         self._context_state: np.ndarray | None = None  # robot_state in self._context
         self._mass_kg = plant.CalcTotalMass(self._context, [self._instance])
         self._heels = [(robot.frame(plant, s), np.asarray(p)) for s, p in heel_points.items()]
+        self._thighs = [
+            (plant.GetFrameByName(f, self._instance), np.asarray(p))
+            for f, p in (thigh_points or {}).items()
+        ]
         nx = plant.num_multibody_states(self._instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         self._wrenches = self.DeclareVectorInputPort("hand_wrenches_W", 12)
@@ -58,6 +79,9 @@ class RobotSensing(LeafSystem):
             )
         self.DeclareVectorOutputPort(
             "heel_x_W", 1, self._CalcHeelX, prerequisites_of_calc=state_only
+        )
+        self.DeclareVectorOutputPort(
+            "thigh_x_W", 1, self._CalcThighX, prerequisites_of_calc=state_only
         )
         self.DeclareVectorOutputPort(
             "omega_f_W", 3, self._CalcOmegaF, prerequisites_of_calc={self._wrenches.ticket()}
@@ -93,6 +117,16 @@ class RobotSensing(LeafSystem):
             for frame, p in self._heels
         ]
         output.SetAtIndex(0, max(xs) if xs else np.nan)
+
+    def _CalcThighX(self, context: Context, output: BasicVector) -> None:
+        self._set_plant_state(context, check=True)
+        plant, c = self._plant, self._context
+        world = plant.world_frame()
+        xs = [
+            plant.CalcPointsPositions(c, frame, p.reshape(3, 1), world)[0, 0]
+            for frame, p in self._thighs
+        ]
+        output.SetAtIndex(0, float(np.mean(xs)) if xs else np.nan)
 
     def _CalcOmegaF(self, context: Context, output: BasicVector) -> None:
         """Omega f = J_com M^-1 sum_h J_h^T F_h (paper, Sec. II).

@@ -104,6 +104,8 @@ class StandupMode:
     # entered again, ends there.
     resume_end_m: tuple[float, float, float] = _NAN3
     sat_back: bool = False  # a hindering pull has sat the robot back since the start
+    # When the release of each seat pad group (phases.SEAT_PADS) began (NaN: seated).
+    release_s: tuple[float, ...] = (math.nan,) * len(SEAT_PADS)
 
     def __copy__(self) -> StandupMode:
         return self
@@ -135,6 +137,9 @@ class Measurements:
     heel_x: float
     foot_fz_N: tuple[float, float]  # left, right
     hand_fx_N: tuple[float, float]  # left, right
+    # The x of the thigh pads' centres (NaN: not measured; a release waiting for the CoM
+    # to pass them never begins).
+    thigh_x: float = math.nan
     # Someone asked for the stand-up (live mode's "Stand up" button): with
     # trigger 'hands', as good as the pull.
     stand_up: bool = False
@@ -202,17 +207,44 @@ def next_mode(
     mode = dataclasses.replace(mode, guards=g, held_back_s=held, hindered_until_s=hindered_until)
     if g.hindered.on:
         if phase.when_hindered == "step_back":
-            left = max(seat_loads(mode, m.t, table)[_released(phase)], default=0.0)
+            loads = np.nan_to_num(seat_loads(mode, m.t, table), nan=1.0)  # NaN: seated
+            left = max(loads[_released(phase)], default=0.0)
             if left > cfg.reseat_above_thigh_load:  # the pads still carry the robot
                 return _sit_back(mode, m, table)
             if left > 0.0:  # unloading: back onto them
-                return _step_back(mode, m)
+                return _step_back(mode, m, table)
         elif phase.when_hindered == "sit_back" and not mode.stepped_back():
             return _sit_back(mode, m, table)
+    mode = _begin_releases(mode, phase, m)
     calm = not g.hindered.on and m.t - mode.hindered_until_s >= cfg.resume_after_s
     if mode.state == N_STATES or not (calm and guard_holds(phase, mode, m, cfg)):
         return mode
     return _enter(mode, mode.state + 1, m, table)
+
+
+def _begin_releases(mode: StandupMode, phase: Phase, m: Measurements) -> StandupMode:
+    """The release of the pads phase unloads begins, where it has not yet: at once, or
+    once the CoM has passed the thigh pads by phase.unload_when."""
+    waiting = [
+        k
+        for k, pads in enumerate(SEAT_PADS)
+        if pads in phase.unload and math.isnan(mode.release_s[k])
+    ]
+    if not waiting:
+        return mode
+    if phase.unload_when is not None and not m.com_W[0] >= m.thigh_x + phase.unload_when:
+        return mode
+    release = list(mode.release_s)
+    for k in waiting:
+        release[k] = m.t
+    return dataclasses.replace(mode, release_s=tuple(release))
+
+
+def released_for_s(mode: StandupMode, phase: Phase, t: float) -> float:
+    """How long the release of every pad group phase unloads has been going on at t (inf:
+    it unloads none; NaN: one has not begun)."""
+    since = [t - mode.release_s[k] for k, pads in enumerate(SEAT_PADS) if pads in phase.unload]
+    return min(since, default=math.inf)
 
 
 def guard_holds(phase: Phase, mode: StandupMode, m: Measurements, cfg: StandupConfig) -> bool:
@@ -229,7 +261,7 @@ def guard_holds(phase: Phase, mode: StandupMode, m: Measurements, cfg: StandupCo
         m.psi - mode.psi_entry >= mode.segment_psi or not any(mode.delta_m)
     ):
         return False
-    if guard.unloaded and dwell < phase.unload_s:
+    if guard.unloaded and not released_for_s(mode, phase, m.t) >= phase.unload_s:
         return False
     if guard.feet_force_N is not None and not g.feet_loaded[k].on:
         return False
@@ -263,10 +295,11 @@ def _sit_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupM
         delta_m=tuple(float(a - b) for a, b in zip(mode.x_seated_m, x_now, strict=True)),
         resume_end_m=_NAN3,
         sat_back=True,
+        release_s=(math.nan,) * len(SEAT_PADS),
     )
 
 
-def _step_back(mode: StandupMode, m: Measurements) -> StandupMode:
+def _step_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMode:
     """Back to the previous phase while this one's pads unload: they are seated again
     (they carry what the chair gives) and the reference stops where it is (psi = t,
     nothing advances). Once the pull has stopped, the previous phase's guard (calm among
@@ -275,8 +308,11 @@ def _step_back(mode: StandupMode, m: Measurements) -> StandupMode:
     x_now = path(mode.segment(), m.psi)[0]
     entry = list(mode.entry_times_s)
     entry[mode.state - 1] = math.nan
+    left = table.phase(mode.state).unload
+    release = [math.nan if pads in left else s for pads, s in zip(SEAT_PADS, mode.release_s)]
     return dataclasses.replace(
         mode,
+        release_s=tuple(release),
         state=mode.state - 1,
         entry_times_s=tuple(entry),
         psi_entry=m.psi,
@@ -303,7 +339,7 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
         delta[:2] = np.array(mode.resume_end_m[:2]) - x_start[:2]
     entry = list(mode.entry_times_s)
     entry[state - 1] = m.t
-    return dataclasses.replace(
+    entered = dataclasses.replace(
         mode,
         state=state,
         entry_times_s=tuple(entry),
@@ -313,21 +349,22 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
         delta_m=tuple(float(v) for v in delta),
         resume_end_m=_NAN3,
     )
+    return _begin_releases(entered, phase, m)
 
 
 # The seat pads, as seat_loads orders them, and their pad group (phases.SEAT_PADS).
 SEAT_LOADS = ("buttocks", "thighs", "thighs")
 
 
-def seat_releases(table: PhaseTable) -> list[tuple[int, float, list[int]]]:
-    """(the state whose entry starts the release, over how long, s, the entries of
-    SEAT_LOADS) of each pad group the table releases."""
+def seat_releases(table: PhaseTable) -> list[tuple[int, float, list[int], int]]:
+    """(the state that releases it, over how long, s, the entries of SEAT_LOADS, its index
+    in SEAT_PADS) of each pad group the table releases."""
     releases = []
-    for pads in SEAT_PADS:
+    for k, pads in enumerate(SEAT_PADS):
         state = table.unloading_phase(pads)
         if state is not None:
             rows = [i for i, name in enumerate(SEAT_LOADS) if name == pads]
-            releases.append((state, table.phase(state).unload_s, rows))
+            releases.append((state, table.phase(state).unload_s, rows, k))
     return releases
 
 
@@ -336,22 +373,24 @@ def seat_loads(
 ) -> np.ndarray:
     """What is left of the load of the buttocks and of each thigh (SEAT_LOADS), as a
     fraction of their load when their release began; NaN while the pad is seated. A pad
-    group is released from the entry of the phase that lists it in unload (from then on,
-    until the robot is back in an earlier phase), smoothstep from 1 to 0 over its
-    unload_s. table: the phase table, or its seat_releases."""
+    group is released from mode.release_s (in the phase that lists it in unload, at its
+    entry or once its unload_when holds; until the robot is back in an earlier phase),
+    smoothstep from 1 to 0 over its unload_s. table: the phase table, or its
+    seat_releases."""
     releases = seat_releases(table) if isinstance(table, PhaseTable) else table
     loads = np.full(len(SEAT_LOADS), math.nan)
-    for state, over_s, rows in releases:
-        if mode.state >= state:
-            since = t - mode.entry_times_s[state - 1]
-            loads[rows] = 0.0 if over_s <= 0 else smoothstep(1.0 - since / over_s)
+    for _, over_s, rows, k in releases:
+        began = mode.release_s[k]
+        if not math.isnan(began):
+            loads[rows] = 0.0 if over_s <= 0 else smoothstep(1.0 - (t - began) / over_s)
     return loads
 
 
 class StandupStateMachine(LeafSystem):
     """Periodic (standup.update_period_s) state machine with the mode as abstract state.
 
-    Inputs: psi (1), com_W (3), heel_x_W (1), pad_forces_W (3 per pad, rows of the soles
+    Inputs: psi (1), com_W (3), heel_x_W (1), thigh_x_W (1; unconnected: never passed),
+    pad_forces_W (3 per pad, rows of the soles
     given as sole_rows = (left, right)), hand_wrenches_W (12, payloads.HAND_WRENCHES), and
     stand_up (1; > 0.5: go; unconnected: never), which only the live helper has.
     Outputs: mode (abstract StandupMode), standup_state (1), advances (1: the phase lets
@@ -376,6 +415,7 @@ class StandupStateMachine(LeafSystem):
         self._psi = self.DeclareVectorInputPort("psi", 1)
         self._com = self.DeclareVectorInputPort("com_W", 3)
         self._heel = self.DeclareVectorInputPort("heel_x_W", 1)
+        self._thigh = self.DeclareVectorInputPort("thigh_x_W", 1)
         self._pads = self.DeclareVectorInputPort("pad_forces_W", 3 * n_pads)
         self._hands = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         self._stand_up = self.DeclareVectorInputPort("stand_up", 1)
@@ -417,6 +457,9 @@ class StandupStateMachine(LeafSystem):
             psi=float(self._psi.Eval(context)[0]),
             com_W=self._com.Eval(context),
             heel_x=float(self._heel.Eval(context)[0]),
+            thigh_x=float(self._thigh.Eval(context)[0])
+            if self._thigh.HasValue(context)
+            else math.nan,
             foot_fz_N=(float(pads[left, 2]), float(pads[right, 2])),
             hand_fx_N=(float(hands[0, 3]), float(hands[1, 3])),
             stand_up=self._stand_up.HasValue(context) and self._stand_up.Eval(context)[0] > 0.5,
@@ -447,11 +490,12 @@ class StandupStateMachine(LeafSystem):
         t = context.get_time()
         loads = seat_loads(mode, t, self._table)
         k = self._table.unloading_phase("thighs")
-        if mode.state < k:
+        began = mode.release_s[SEAT_PADS.index("thighs")]
+        if math.isnan(began):
             scale = 1.0
         else:
             over = self._table.phase(k).unload_s
-            scale = 0.0 if over <= 0 else max(0.0, 1.0 - (t - mode.entry_times_s[k - 1]) / over)
+            scale = 0.0 if over <= 0 else max(0.0, 1.0 - (t - began) / over)
         output.SetFromVector(np.r_[mode.state, scale, 1.0, loads])
 
     def _CalcEntryTimes(self, context: Context, output: BasicVector) -> None:

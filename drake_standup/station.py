@@ -17,7 +17,7 @@ Outputs
     seat_pad_normal_forces_N  (3) normal force on the buttocks, left and right thigh pads
     pads_vertical_force_N     (1) the vertical force on all the robot's pads
     hand_wrenches_W           (12) the hands' sensors' wrenches (payloads.HAND_WRENCHES)
-    com_W, com_velocity_W, omega_f_W, heel_x_W   sensing.py
+    com_W, com_velocity_W, omega_f_W, heel_x_W, thigh_x_W   sensing.py
     push_force_W              (3) only with perturbation.pushes
 """
 
@@ -36,7 +36,7 @@ from drake_standup.payloads import HAND_WRENCHES
 from drake_standup.perturbations import NoisyWrenchSensor, PushSource
 from drake_standup.robot import ActuatedJoints, Robot, actuated_joints
 from drake_standup.scene import Scene, add_scene
-from drake_standup.sensing import RobotSensing, heel_points
+from drake_standup.sensing import RobotSensing, heel_points, thigh_points
 
 # Pad groups as metrics.json reports them (plural where there are two).
 _GROUP_LABELS = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
@@ -125,11 +125,13 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
     measured = sensor.get_output_port()
     builder.ExportOutput(measured, "hand_wrenches_W")
 
-    sensing = builder.AddNamedSystem("sensing", RobotSensing(plant, robot, heel_points(robot)))
+    sensing = builder.AddNamedSystem(
+        "sensing", RobotSensing(plant, robot, heel_points(robot), thigh_points(robot))
+    )
     robot_state = plant.get_state_output_port(instance)
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
     builder.Connect(measured, sensing.GetInputPort("hand_wrenches_W"))
-    for name in ("com_W", "com_velocity_W", "omega_f_W", "heel_x_W"):
+    for name in ("com_W", "com_velocity_W", "omega_f_W", "heel_x_W", "thigh_x_W"):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
 
     builder.ExportInput(plant.get_actuation_input_port(instance), "actuation")

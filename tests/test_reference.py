@@ -95,6 +95,7 @@ def test_path_is_continuous_in_value_and_slope_across_switches():
             heel_x=0.1,
             foot_fz_N=(200.0, 200.0),
             hand_fx_N=(0.0, 0.0),
+            thigh_x=0.0,  # and of the thigh pads
         )
         new = next_mode(mode, m, cfg, table)
         if new.state != mode.state:

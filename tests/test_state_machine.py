@@ -19,6 +19,7 @@ from drake_standup.state_machine import (
     SchmittTrigger,
     StandupStateMachine,
     _enter,
+    _sit_back,
     initial_mode,
     next_mode,
     seat_loads,
@@ -49,8 +50,8 @@ COM0 = np.array([0.06, 0.0, 0.38])
 AHEAD = np.array([0.30, 0.0, 0.40])  # CoM far in front of the heels
 
 
-def _m(t, psi=None, com=AHEAD, heel_x=0.1, feet=(200.0, 200.0), hands=(20.0, 20.0)):
-    return Measurements(t, t if psi is None else psi, com, heel_x, feet, hands)
+def _m(t, psi=None, com=AHEAD, heel_x=0.1, feet=(200.0, 200.0), hands=(20.0, 20.0), thigh_x=0.0):
+    return Measurements(t, t if psi is None else psi, com, heel_x, feet, hands, thigh_x)
 
 
 def _settled(mode, m, cfg=CFG, table=TABLE):
@@ -147,6 +148,7 @@ def test_leaf_system_switches_on_its_update_grid():
     pads[0, 2] = pads[1, 2] = 200.0
     system.GetInputPort("com_W").FixValue(context, AHEAD)
     system.GetInputPort("heel_x_W").FixValue(context, [0.1])
+    system.GetInputPort("thigh_x_W").FixValue(context, [0.0])
     system.GetInputPort("pad_forces_W").FixValue(context, pads.reshape(-1))
     system.GetInputPort("hand_wrenches_W").FixValue(context, np.zeros(12))
     psi_port = system.GetInputPort("psi")
@@ -166,6 +168,44 @@ def test_leaf_system_switches_on_its_update_grid():
     assert system.GetOutputPort("standup_state").Eval(context)[0] == 4
     loads = seat_loads(system.GetOutputPort("mode").Eval(context), 8.0, TABLE)
     np.testing.assert_array_equal(loads, 0.0)  # the seat released by t = 8 s
+
+
+def test_the_buttocks_release_waits_for_the_com_to_pass_the_thigh_pads():
+    """State 2's release begins at the first update with the CoM unload_when in front of
+    the thigh pads' centres (not at entry: behind them, the chair still carries the
+    robot), the pads unload over unload_s from then, and the exit waits for that."""
+    ahead = FORWARD.unload_when
+    assert ahead is not None and FORWARD.exit.unloaded
+    thigh = 0.2
+    behind = np.array([thigh + ahead - 1e-6, 0.0, 0.40])
+    mode = _enter(initial_mode(COM0), 2, _m(3.0, com=behind, thigh_x=thigh), TABLE)
+    assert np.isnan(seat_loads(mode, 3.0, TABLE)).all()  # entered: still seated
+    t = 3.0 + 2 * FORWARD.segment_psi  # segment done, feet loaded, CoM ahead of the heels
+    mode = _next(mode, _m(t, com=behind, thigh_x=thigh), CFG)
+    assert mode.state == 2 and np.isnan(seat_loads(mode, t, TABLE)).all()
+    passed = behind + np.array([2e-6, 0.0, 0.0])
+    mode = _next(mode, _m(t, com=passed, thigh_x=thigh), CFG)
+    assert mode.state == 2 and mode.release_s[0] == t  # the release begins, no exit yet
+    np.testing.assert_allclose(seat_loads(mode, t, TABLE)[0], 1.0)
+    np.testing.assert_allclose(seat_loads(mode, t + FORWARD.unload_s / 2, TABLE)[0], 0.5)
+    assert np.isnan(seat_loads(mode, t + 1.0, TABLE)[1:]).all()  # the thighs stay seated
+    early = t + FORWARD.unload_s - 0.01
+    assert _next(mode, _m(early, com=passed, thigh_x=thigh), CFG).state == 2
+    done = t + FORWARD.unload_s
+    assert _next(mode, _m(done, com=passed, thigh_x=thigh), CFG).state == 3
+    # Unmeasured (NaN) thighs: a release that waits for them never begins.
+    blind = _next(mode, _m(t, com=passed, thigh_x=math.nan), CFG)
+    assert blind.release_s == mode.release_s  # begun releases stay begun
+    unseen = _enter(initial_mode(COM0), 2, _m(3.0, thigh_x=math.nan), TABLE)
+    assert math.isnan(_next(unseen, _m(t, thigh_x=math.nan), CFG).release_s[0])
+
+
+def test_a_sit_back_seats_every_pad_again():
+    mode = _enter(initial_mode(COM0), 2, _m(3.0), TABLE)
+    assert mode.release_s[0] == 3.0
+    back = _sit_back(mode, _m(3.1), TABLE)
+    assert back.state == 1 and np.isnan(back.release_s).all()
+    assert np.isnan(seat_loads(back, 3.2, TABLE)).all()
 
 
 def test_entry_times_are_nan_until_reached():

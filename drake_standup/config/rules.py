@@ -96,7 +96,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
         "human.reactive.ease_com_rise_m advancement.alpha_*_mps2 advancement.lag_tolerance_m "
         "standup.*_s standup.*_N phases.*.unload_s phases.*.exit.* phases.*.com_kp_per_s2 "
-        "controller.*_weight "
+        "controller.*_weight controller.contact_velocity_gain_per_s "
         "controller.*weight_by_joint.* controller.*_kp_* controller.*_kd_* controller.*_ki_* "
         "controller.*_damping_ratio controller.posture_limit_margin_rad controller.*_N "
         "controller.lean_max_* controller.mass_estimation_filter_s seat_hold.* "
@@ -107,6 +107,9 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     ),
     (PLANT_STEP, "plant.time_step"),
     (Range(low=1.0), "advancement.psi_dot_upper"),
+    # Where the seat's release waits for the CoM, about the thigh pads: within a thigh's
+    # length of them. m.
+    (Range(low=-0.3, high=0.3), "phases.*.unload_when"),
     (Range(high=1.0, high_open=True), "advancement.taper_from_progress"),
     (Range(high=1.0, high_open=True), "controller.stance_from_progress"),
     (
