@@ -104,12 +104,13 @@ class _Rig:
         self.context = self.diagram.CreateDefaultContext()
         self.controller_context = self.controller.GetMyContextFromRoot(self.context)
 
-    def fix(self, x, com_reference, standup_state, hands=NO_PULL):
-        """Inputs of a tick in standup_state with every seat pad seated."""
-        seated = np.full(3, math.nan)
+    def fix(self, x, com_reference, standup_state, hands=NO_PULL, loads=None):
+        """Inputs of a tick in standup_state with the seat pads' loads (seat_loads: None,
+        every pad seated; released ones from 100 N)."""
+        loads = np.full(3, math.nan) if loads is None else np.asarray(loads, dtype=float)
         mode = dataclasses.replace(initial_mode(np.zeros(3)), state=standup_state)
         commands = contact_commands(
-            self.config, seated, np.zeros(3), None, phase_seat_hold(mode, self.table)
+            self.config, loads, np.full(3, 100.0), None, phase_seat_hold(mode, self.table)
         )
         inputs = {
             "robot_state": x,
@@ -249,8 +250,9 @@ def test_solution_satisfies_dynamics_and_contact_limits(scene, standup_state):
 
 
 def test_cop_boxes_lie_on_their_pads(scene):
-    """The seat's CoP box lies on the buttocks pad and each sole's on its sole pad, at
-    least 5 mm inside (pad boxes from models/icub_contact.yaml, seated pose)."""
+    """The seat's CoP box lies on the buttocks pad, each thigh's on its thigh pad and each
+    sole's on its sole pad, at least 5 mm inside (pad boxes from models/icub_contact.yaml,
+    seated pose)."""
     import yaml
 
     from drake_standup.robot import CONTACT_FILE
@@ -260,7 +262,13 @@ def test_cop_boxes_lie_on_their_pads(scene):
     context = plant.CreateDefaultContext()
     plant.SetPositionsAndVelocities(context, robot.model_instance, x0)
     pads = {shape["name"]: shape for shape in yaml.safe_load(CONTACT_FILE.read_text())["shapes"]}
-    pad_of = {"seat": "buttocks_pad", "l_sole": "l_sole_pad", "r_sole": "r_sole_pad"}
+    pad_of = {
+        "seat": "buttocks_pad",
+        "l_thigh": "l_thigh_pad",
+        "r_thigh": "r_thigh_pad",
+        "l_sole": "l_sole_pad",
+        "r_sole": "r_sole_pad",
+    }
     for spec in contact_specs(plant, robot, ControllerConfig()):
         if spec.point:
             continue
@@ -402,6 +410,48 @@ def test_hold_point_velocity_and_bias_acceleration_by_finite_differences(scene):
             A_WP = (ahead[j][2] - behind[j][2]) / (2 * dt)
             Jdotv_WP = (R_WF @ terms.Jdotv_P[j].reshape(2, 3).T).T.reshape(6)
             np.testing.assert_allclose(Jdotv_WP, A_WP, atol=1e-5 * max(1.0, np.abs(A_WP).max()))
+
+
+@pytest.mark.parametrize("gain", [0.0, 20.0])
+def test_held_contacts_brake_their_slip(scene, gain):
+    """Once the buttocks are off the seat, with the thighs on it: on random moving
+    states, each sole's six rows and each thigh's pitch and normal rows obey
+    J_P vdot + Jdot_P v = -k J_P v (Drake's Jacobian and bias acceleration of the frame,
+    expressed in it), so a contact that has begun to slip is braked back to rest; the
+    thighs' other rows are left free (their acceleration is not held)."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    rig = _Rig(scene, contact_velocity_gain_per_s=gain)
+    context = plant.CreateDefaultContext()
+    rng = np.random.default_rng(20)
+    free_seen = 0.0
+    for _ in range(N_SAMPLES // 2):
+        x = _random_state(plant, instance, x0, rng)
+        com = _com(plant, instance, x)
+        rig.fix(x, np.concatenate([com, np.zeros(6)]), 2, loads=[0.0, math.nan, math.nan])
+        solution = rig.tick()
+        assert solution.ok and not solution.relaxed
+        seat = solution.frames.index("seat")
+        np.testing.assert_allclose(solution.F_C[seat], 0.0, atol=1e-6)  # released: no load
+        plant.SetPositionsAndVelocities(context, instance, x)
+        v = x[plant.num_positions() :]
+        for name in ("l_sole", "r_sole", "l_thigh", "r_thigh"):
+            frame = robot.frame(plant, name)
+            J = plant.CalcJacobianSpatialVelocity(
+                context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
+            )
+            bias = plant.CalcBiasSpatialAcceleration(
+                context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
+            ).get_coeffs()
+            acceleration, velocity = J @ solution.vdot + bias, J @ v
+            rows = [0, 1, 2, 3, 4, 5] if "sole" in name else [1, 5]
+            np.testing.assert_allclose(
+                acceleration[rows], -gain * velocity[rows], atol=1e-6 * max(1.0, gain)
+            )
+            if "thigh" in name:
+                free_seen = max(free_seen, np.abs(acceleration[[0, 2, 3, 4]]).max())
+    assert free_seen > 1e-3  # the thighs' free rows do move
 
 
 # --- The human's help ------------------------------------------------------------------------

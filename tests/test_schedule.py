@@ -29,7 +29,8 @@ MARGIN = 20.0  # controller.seat_measured_margin_N
 
 
 def _m(t: float) -> Measurements:
-    return Measurements(t, t, np.array([0.06, 0.0, 0.38]), 0.1, (0.0, 0.0), (0.0, 0.0))
+    # The CoM 6 cm ahead of the thigh pads: the buttocks' release begins at entry.
+    return Measurements(t, t, np.array([0.06, 0.0, 0.38]), 0.1, (0.0, 0.0), (0.0, 0.0), 0.0)
 
 
 def test_the_defaults_are_the_documented_bounds():
@@ -48,7 +49,7 @@ def test_seated_pads_get_the_seated_bounds_and_the_phase_hold():
 def test_a_releasing_pad_is_bounded_by_what_is_left_and_by_what_it_carries():
     """The buttocks with half their load left, released from 120 N, carrying 30 N: at
     most min(0.5 x 120, 30 + 20) = 50 N, at least 0; the seated thighs keep [10, 400];
-    the seat holds no rows once the buttocks release."""
+    the seat keeps the phase's hold while the buttocks unload."""
     loads = np.array([0.5, math.nan, math.nan])
     commands = contact_commands(
         CONFIG, loads, np.array([120.0, 80.0, 80.0]), np.array([30.0, 55.0, 55.0]), "hinged"
@@ -56,7 +57,7 @@ def test_a_releasing_pad_is_bounded_by_what_is_left_and_by_what_it_carries():
     assert commands.min_normal_force_N[0] == 0.0 and commands.max_normal_force_N[0] == 50.0
     np.testing.assert_array_equal(commands.min_normal_force_N[1:3], [F_MIN, F_MIN])
     np.testing.assert_array_equal(commands.max_normal_force_N[1:3], [SEAT_MAX, SEAT_MAX])
-    assert commands.seat_hold == "free"
+    assert commands.seat_hold == "hinged" and not commands.thighs_held
     # Measured above what is left: the fraction binds (0.25 x 80 = 20 < 55 + 20).
     loads = np.array([0.0, 0.25, 0.25])
     commands = contact_commands(
@@ -69,6 +70,24 @@ def test_a_releasing_pad_is_bounded_by_what_is_left_and_by_what_it_carries():
         CONFIG, np.array([1.0, math.nan, math.nan]), np.array([200.0, 0, 0]), -np.ones(3), "held"
     )
     assert commands.max_normal_force_N[0] == MARGIN
+
+
+def test_holds_follow_the_release_no_contact_is_counted_on_while_the_motion_lifts_it():
+    """(buttocks, thighs) left -> (seat hold, thighs held): the seat keeps its phase's
+    hold until the buttocks' release is over, then holds no rows; from then the thighs'
+    pitch and normal rows are held until their own release is over (a pad the QP still
+    counts on is not lifted by the plan), then neither."""
+    cases = [
+        ((math.nan, math.nan), ("hinged", False)),  # seated
+        ((0.4, math.nan), ("hinged", False)),  # the buttocks unloading
+        ((0.0, math.nan), ("free", True)),  # the buttocks off, the thighs seated
+        ((0.0, 0.3), ("free", True)),  # the thighs unloading: still held
+        ((0.0, 0.0), ("free", False)),  # all off: the chair leaves the QP
+    ]
+    for (buttocks, thighs), expected in cases:
+        loads = np.array([buttocks, thighs, thighs])
+        commands = contact_commands(CONFIG, loads, np.full(3, 100.0), None, "hinged")
+        assert (commands.seat_hold, commands.thighs_held) == expected, (buttocks, thighs)
 
 
 def test_the_chair_leaves_the_qp_once_every_seat_pad_is_released():

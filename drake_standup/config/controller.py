@@ -68,6 +68,10 @@ class ControllerConfig:
     friction_coefficient: float = 1.0 / 3.0
     # Torsional friction |tau_z| <= mu_t f_z (SPEC 3). m.
     torsional_friction_coefficient_m: float = 1.0 / 75.0
+    # A held contact's rows ask J vdot + Jdot v = -k J v: a foot that has begun to slip
+    # (a pull the pads' friction barely holds) is braked back to rest instead of being
+    # left to drift (docs/design.md, "Held contacts brake their slip"). 1/s.
+    contact_velocity_gain_per_s: float = 20.0
     # Minimum normal force of a seated pad and of each sole (SPEC 3). N.
     min_normal_force_N: float = 10.0
     # A seated pad's normal-force bound: above the robot's weight (324 N), never binding. N.
@@ -86,6 +90,11 @@ class ControllerConfig:
     # contacts of their own. m.
     seat_cop_x_m: list[float] = field(default_factory=lambda: [-0.11, -0.06])
     seat_cop_y_m: list[float] = field(default_factory=lambda: [-0.05, 0.05])
+    # CoP box of each thigh contact in its frame: the 0.14 x 0.09 m pad, 2 cm inside
+    # (models/icub_contact.yaml); a flat thigh on the chair resists pitching and rolling,
+    # which a point force does not model. m.
+    thigh_cop_x_m: list[float] = field(default_factory=lambda: [-0.05, 0.05])
+    thigh_cop_y_m: list[float] = field(default_factory=lambda: [-0.025, 0.025])
     # Joint torque saturation, N m. None: the actuators' effort limit in the plant
     # (robot.effort_limit_Nm, SPEC 3); a number: a tighter limit of the controller's own.
     torque_limit_Nm: float | None = None
@@ -103,9 +112,10 @@ class ControllerConfig:
     stance_vertical_weight_scale: float = 0.1
     # Integral gain on the CoM height error in the stance (control/references.py). 1/s^3.
     stance_height_ki_per_s3: float = 100.0
-    # The lean's first-order lag: the pull's moment, not its jitter, and a slow return
-    # when a helper lets go. s.
-    lean_filter_time_constant_s: float = 0.8
+    # The lean's first-order lag: the pull's moment, not its jitter, and about the CoM
+    # loop's own time, so that a robot leaning into a pull is upright soon after the
+    # helper lets go (docs/design.md, "The controller's settings"). s.
+    lean_filter_time_constant_s: float = 0.2
     # Bounds of the lean: the CoM target stays over the soles' CoP box with ~1.7 cm to
     # spare, so that the robot still stands when the pull stops; a pull that needs more
     # is beyond what the feet allow. m.

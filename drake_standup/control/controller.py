@@ -69,7 +69,8 @@ class Program:
 
     qp: WholeBodyQp
     contact_index: np.ndarray  # of each of its contacts in CONTACTS
-    partially_held: dict[str, dict[int, np.ndarray]]  # HOLDS -> ContactCommands'
+    # (HOLDS, thighs held) -> ContactCommands'
+    partially_held: dict[tuple[str, bool], dict[int, np.ndarray]]
 
 
 def make_program(
@@ -151,19 +152,32 @@ def make_program(
         ),
         soft_bound_weight=config.joint_limit_weight,
         solver=config.qp_solver,
+        contact_velocity_gain_per_s=config.contact_velocity_gain_per_s,
     )
     # The seat's held rows: all (held), all but its pitch about the hip axis (hinged:
-    # alpha_y in C), none (free).
+    # alpha_y in C), none (free); the thighs': their pitch and normal, or none.
     seat = [c for c, spec in enumerate(contacts) if spec.frame == "seat"]
+    thighs = [c for c, spec in enumerate(contacts) if spec.frame in ("l_thigh", "r_thigh")]
     hinged = np.ones(WRENCH_SIZE, dtype=bool)
     hinged[1] = False
-    rows = {"held": None, "hinged": hinged, "free": np.zeros(WRENCH_SIZE, dtype=bool)}
+    rows = {
+        "held": np.ones(WRENCH_SIZE, dtype=bool),
+        "hinged": hinged,
+        "free": np.zeros(WRENCH_SIZE, dtype=bool),
+    }
+    # A flat thigh on the chair: it neither sinks nor pitches (alpha_y, a_z in C).
+    normal = np.zeros(WRENCH_SIZE, dtype=bool)
+    normal[[1, NORMAL]] = True
+    partially_held = {}
+    for hold in HOLDS:
+        for thighs_held in (False, True):
+            held = {c: rows[hold] for c in seat}
+            held.update({c: normal if thighs_held else rows["free"] for c in thighs})
+            partially_held[(hold, thighs_held)] = held
     return Program(
         qp=qp,
         contact_index=np.array([CONTACTS.index(spec.frame) for spec in contacts]),
-        partially_held={
-            hold: {} if rows[hold] is None else {c: rows[hold] for c in seat} for hold in HOLDS
-        },
+        partially_held=partially_held,
     )
 
 
@@ -253,7 +267,7 @@ class WholeBodyController(LeafSystem):
                 QpContactCommands(
                     commands.min_normal_force_N[index],
                     commands.max_normal_force_N[index],
-                    program.partially_held[commands.seat_hold],
+                    program.partially_held[(commands.seat_hold, commands.thighs_held)],
                 ),
             )
         solution = program.qp.solve(terms, references, self._last[1])

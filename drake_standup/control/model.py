@@ -54,11 +54,14 @@ def contact_specs(
         "torsional_friction_coefficient": config.torsional_friction_coefficient_m,
     }
     seat_box = {"cop_x_m": tuple(config.seat_cop_x_m), "cop_y_m": tuple(config.seat_cop_y_m)}
+    thigh_box = {"cop_x_m": tuple(config.thigh_cop_x_m), "cop_y_m": tuple(config.thigh_cop_y_m)}
     foot_box = {"cop_x_m": tuple(config.foot_cop_x_m), "cop_y_m": tuple(config.foot_cop_y_m)}
     return [
         ContactSpec("seat", **friction, **seat_box, hold_point_m=tuple(p_SeatHinge.tolist())),
-        ContactSpec("l_thigh", **friction, point=True, constrained=False),
-        ContactSpec("r_thigh", **friction, point=True, constrained=False),
+        # Held (their pitch and normal rows, control/schedule.py) while the buttocks are
+        # off the seat and the thighs still on it: the QP counts on their wrench then.
+        ContactSpec("l_thigh", **friction, **thigh_box),
+        ContactSpec("r_thigh", **friction, **thigh_box),
         ContactSpec("l_sole", **friction, **foot_box),
         ContactSpec("r_sole", **friction, **foot_box),
     ]

@@ -10,7 +10,11 @@ both soles (6-D). The phase table (phases.py) says when each seat pad's load is 
     releasing pad              f_z in [0, min(left * F_0, F_measured + margin)]
     sole                       f_z in [f_min, f_max_foot]
     seat hold                  the phase's seat_hold (seat_hold_sat_back after a sit-back)
-                               while the buttocks are seated; no rows once they release
+                               until the buttocks' release is over; no rows then
+    thighs held                their pitch and normal rows once the buttocks are off,
+                               until the thighs' own release is over: the QP counts on
+                               their wrench, so it may not plan motions that lift them
+                               while they still carry load
 
 F_0 is what the controller commanded the pad when its release began (the schedule's
 memory: a pad lifting off cannot push). The measured bound: the thighs are forces the QP
@@ -47,6 +51,7 @@ class ContactCommands:
     min_normal_force_N: np.ndarray  # (5,) f_z bounds, N
     max_normal_force_N: np.ndarray  # (5,)
     seat_hold: str  # HOLDS: the seat's rows held (all, all but the hip pitch, none)
+    thighs_held: bool = False  # the thighs' normal rows held
 
 
 def next_unload_from(
@@ -71,6 +76,7 @@ def contact_commands(
     and the phase's seat hold."""
     releasing = np.isfinite(loads)
     chair = bool(np.any(~releasing | (loads > 0.0)))
+    seat_off = bool(releasing[0] and loads[0] <= 0.0)  # the buttocks' release is over
     low = np.full(len(CONTACTS), config.min_normal_force_N)
     high = np.empty(len(CONTACTS))
     high[CHAIR] = config.seat_max_normal_force_N
@@ -86,7 +92,8 @@ def contact_commands(
         active=(chair, chair, chair, True, True),
         min_normal_force_N=low,
         max_normal_force_N=high,
-        seat_hold="free" if releasing[0] else seat_hold,
+        seat_hold="free" if seat_off else seat_hold,
+        thighs_held=bool(seat_off and not (releasing[1] and loads[1] <= 0.0)),
     )
 
 
@@ -119,7 +126,7 @@ class ContactScheduler(LeafSystem):
             hold: contact_commands(config, seated, seated, None, hold) for hold in HOLDS
         }
         self._released = contact_commands(config, np.zeros(3), np.zeros(3), None, "free")
-        self._first_release = min((state for state, _, _ in self._releases), default=math.inf)
+        self._first_release = min((release[0] for release in self._releases), default=math.inf)
         self._mode = self.DeclareAbstractInputPort("mode", Value[object](StandupMode()))
         self._measured = self.DeclareVectorInputPort("seat_pad_normal_forces_N", 3)
         self._commanded = self.DeclareVectorInputPort("commanded_normal_forces_N", len(CONTACTS))
