@@ -14,7 +14,8 @@ The program, built once and refilled every tick:
 
     min_z  sum_k w_k ||A_k z - b_k||^2 + w_tau ||T z + t0||^2 + w_F ||F||^2 + w_a ||vdot||^2
     s.t.   S_f (M vdot - sum_c G_c F_c) = S_f (J_h^T F_hand - h)     dynamics, base rows
-           S_c (J_c vdot + Jdot_c v) = 0              each held contact (S_c: held rows)
+           S_c (J_c vdot + Jdot_c v) = -k S_c J_c v    each held contact (S_c: held rows;
+                                                      k: a slip braked back to rest)
            K_c F_c <= 0,  f_z,c in [lo_c, hi_c]       each contact
            -tau_max <= T z + t0 <= tau_max            torque limits
            vdot_min <= vdot <= vdot_max               joint limits (control/tasks.py)
@@ -211,6 +212,7 @@ class WholeBodyQp:
         soft_bounds: AccelerationBounds | None = None,
         soft_bound_weight: float = 0.0,
         solver: str = "daqp",
+        contact_velocity_gain_per_s: float = 0.0,
     ):
         """contact_map: the active contacts and their map (the tasks may share it).
         tasks: the cost's tasks. acceleration_bounds: bounds on entries of vdot, computed
@@ -226,6 +228,7 @@ class WholeBodyQp:
         self.contacts = contacts = contact_map.contacts
         self.frames = [spec.frame for spec in contacts]
         self._solver = solver
+        self._velocity_gain = contact_velocity_gain_per_s
         self._torque_limit_Nm = torque_limit_Nm
         self._torque_weight = torque_weight
         nw, nc = layout.n_wrench, len(contacts)
@@ -393,9 +396,11 @@ class WholeBodyQp:
         np.add(r[rows], self._dynamics_lo, out=self._lo_dynamics)
         np.add(r[rows], self._dynamics_hi, out=self._hi_dynamics)
 
-        # Held contacts: the held rows of J_CP vdot = -Jdot_CP v, expressed in C.
+        # Held contacts: the held rows of J_CP vdot = -Jdot_CP v - k J_CP v, in C.
         self._A_acc[:] = terms.J_P.reshape(self._A_acc.shape)
         np.negative(terms.Jdotv_P.reshape(-1), out=self._lo_acc)
+        if self._velocity_gain:
+            self._lo_acc -= self._velocity_gain * (self._A_acc @ terms.v)
         self._hi_acc[:] = self._lo_acc
         if commands.partially_held is not self._partially_held:
             self._partially_held = commands.partially_held
