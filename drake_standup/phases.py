@@ -24,6 +24,7 @@ Why these values: docs/design.md, "The phase table". Older scenario files spelle
 of this table as separate keys of standup: and controller: (config/legacy.py reads them).
 """
 
+import copy
 from dataclasses import dataclass, field
 
 # The phases in the order of the stand-up states 1-4.
@@ -87,6 +88,10 @@ class Phase:
     segment_psi: float = 1.0
     com_delta_m: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     com_height_m: float | None = None
+    # Without com_height_m: end at the erect CoM height of this phase's posture on the
+    # scenario's robot (scene.erect_com_height_m, resolved by resolve_com_heights), so
+    # that each model stands at its own height.
+    com_height_erect: bool = False
     start_at_com_height: bool = False
     # CoM stiffness K_P (x, y, z); K_D = 2 zeta sqrt(K_P) (controller.com_damping_ratio).
     # 1/s^2.
@@ -172,11 +177,12 @@ class PhaseTable:
         )
     )
     # 4: up to the erect CoM height (scene.erect_com_height_m of this posture: 0.5753 m
-    # on iCubGazeboV2_5), the legs' posture ending the rise; the final state.
+    # on iCubGazeboV2_5, 0.553 m on iCubGenova01), the legs' posture ending the rise; the
+    # final state.
     rise: Phase = field(
         default_factory=lambda: Phase(
             segment_psi=1.8,
-            com_height_m=0.575,
+            com_height_erect=True,
             com_kp_per_s2=[60.0, 40.0, 30.0],
             posture_rad=posture(
                 [0.2094, 0.1047, -0.1745, -0.0349, -1.6455, 0.4363, 0.5862, 0.2473, 0.0]
@@ -195,9 +201,28 @@ class PhaseTable:
     def __iter__(self):
         return (getattr(self, name) for name in PHASES)
 
+    def unresolved_heights(self) -> list[str]:
+        """The phases whose end height waits for the robot (com_height_erect, no
+        com_height_m)."""
+        return [
+            name
+            for name, phase in zip(PHASES, self, strict=True)
+            if phase.com_height_erect and phase.com_height_m is None
+        ]
+
     def unloading_phase(self, pads: str) -> int | None:
         """The state (1-4) whose entry starts the release of a pad group, None if none."""
         for state, phase in enumerate(self, start=1):
             if pads in phase.unload:
                 return state
         return None
+
+
+def resolve_com_heights(table: PhaseTable, erect_height_m) -> PhaseTable:
+    """A copy of table whose com_height_erect phases without a com_height_m end at
+    erect_height_m(phase.posture_rad) (m)."""
+    resolved = copy.deepcopy(table)
+    for name in table.unresolved_heights():
+        phase = getattr(resolved, name)
+        phase.com_height_m = float(erect_height_m(phase.posture_rad))
+    return resolved

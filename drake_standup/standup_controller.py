@@ -38,7 +38,9 @@ from drake_standup.control.references import (
     TaskReferenceGenerator,
 )
 from drake_standup.control.schedule import ContactScheduler
+from drake_standup.phases import resolve_com_heights
 from drake_standup.reference import CoMReferenceGenerator
+from drake_standup.scene import erect_com_height_m
 from drake_standup.state_machine import StandupStateMachine
 from drake_standup.station import Station
 
@@ -106,7 +108,11 @@ class StandupController:
 def make_standup_controller(scenario: Scenario, station: Station) -> StandupController:
     """The diagram of the module docstring for the station's robot."""
     plant, robot = station.plant, station.robot
-    config, table, period_s = scenario.controller, scenario.phases, scenario.controller_period_s
+    config, period_s = scenario.controller, scenario.controller_period_s
+    # Each robot stands at its own erect height (phases.Phase.com_height_erect).
+    table = resolve_com_heights(
+        scenario.phases, lambda posture: erect_com_height_m(station.scene, scenario, posture)
+    )
     g = -plant.gravity_field().gravity_vector()[2]
     specs = contact_specs(plant, robot, config)
     joints = ControllerJoints.of(plant, robot)

@@ -407,6 +407,11 @@ class StandupStateMachine(LeafSystem):
         sole_rows: tuple[int, int],
     ):
         super().__init__()
+        if table.unresolved_heights():
+            raise ValueError(
+                f"phases {table.unresolved_heights()}: com_height_erect unresolved "
+                "(phases.resolve_com_heights)"
+            )
         self._cfg = config
         self._table = table
         self._advances = [float(phase.advances) for phase in table]

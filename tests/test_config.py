@@ -196,10 +196,15 @@ def _every_key(scenario: Scenario) -> list[tuple[str, object]]:
 
 
 def _full_scenario() -> Scenario:
-    """The assisted scenario with one of everything: a pull, a push, a torque limit."""
+    """The assisted scenario with one of everything: a pull, a push, a torque limit, an
+    absolute end height."""
     return apply_overrides(
         load_scenario("assisted"),
-        [("perturbation.pushes", [{"body": "chest"}]), ("controller.torque_limit_Nm", 50.0)],
+        [
+            ("perturbation.pushes", [{"body": "chest"}]),
+            ("controller.torque_limit_Nm", 50.0),
+            ("phases.rise.com_height_m", 0.575),
+        ],
     )
 
 

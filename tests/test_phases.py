@@ -62,10 +62,14 @@ def test_the_defaults_are_the_sources_numbers():
 
 
 def test_an_older_file_gives_the_default_table():
-    """Every older key at the value it had by default: the same table as no key at all;
-    the keys are gone from the loaded scenario (its scenario.yaml spells the table)."""
+    """Every older key at the value it had by default: the same table as no key at all,
+    but for the standing height, which the older key sets absolute (0.575 m, where the
+    default is now each model's erect height); the keys are gone from the loaded
+    scenario (its scenario.yaml spells the table)."""
     older = parse_scenario(OLDER)
-    assert older.phases == Scenario().phases
+    expected = Scenario().phases
+    expected.rise.com_height_m = 0.575
+    assert older.phases == expected
     assert not hasattr(older.standup, "segment_psi")
     assert not hasattr(older.controller, "lean_states")
 
@@ -171,3 +175,28 @@ def test_every_older_key_is_in_the_older_file_here():
     }
     assert keys | {f"controller.posture_state{k}_rad" for k in (2, 3, 4)} == set(LEGACY)
     assert len(PHASES) == 4
+
+
+@pytest.mark.parametrize(
+    ("model", "height_m"), [("iCubGazeboV2_5", 0.5753), ("iCubGenova01", 0.553)]
+)
+def test_each_robot_rises_to_its_own_erect_height(model, height_m):
+    """The rise ends, by default, at the erect CoM height of its posture on the robot at
+    hand (scene.erect_com_height_m, resolved when the stand-up controller is made): the
+    Gazebo model and a shorter-legged real one differ by 2 cm; a height set in the file
+    stays as it is."""
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_standup.phases import resolve_com_heights
+    from drake_standup.scene import add_scene, erect_com_height_m
+
+    scenario = apply_overrides(Scenario(), [("robot.model", model)])
+    scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
+    table = resolve_com_heights(
+        scenario.phases, lambda posture: erect_com_height_m(scene, scenario, posture)
+    )
+    assert Scenario().phases.rise.com_height_m is None and table.unresolved_heights() == []
+    assert table.rise.com_height_m == pytest.approx(height_m, abs=5e-4)
+    assert scenario.phases.rise.com_height_m is None  # the scenario itself is not changed
+    fixed = apply_overrides(scenario, [("phases.rise.com_height_m", 0.56)])
+    assert resolve_com_heights(fixed.phases, lambda posture: 1.0).rise.com_height_m == 0.56

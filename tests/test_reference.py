@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from drake_standup.config import StandupConfig
-from drake_standup.phases import PhaseTable
+from drake_standup.phases import PhaseTable, resolve_com_heights
 from drake_standup.reference import CoMReferenceGenerator, min_jerk, path
 from drake_standup.state_machine import Measurements, initial_mode, next_mode
 
@@ -81,7 +81,7 @@ def test_path_is_continuous_in_value_and_slope_across_switches():
     """Drive the state machine through states 1-4 with psi = 1.3 t and check
     x_d and d_psi x_d just before and after every switch."""
     cfg = StandupConfig(trigger="time")
-    table = PhaseTable()
+    table = resolve_com_heights(PhaseTable(), lambda posture: 0.575)
     com0 = np.array([0.06, 0.0, 0.38])
     mode = initial_mode(com0)
     segments = [mode.segment()]

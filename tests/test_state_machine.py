@@ -34,6 +34,7 @@ def _table(**exits) -> PhaseTable:
     the dwell to psi), so the dwell guards are exercised too; exits: more of it, as
     {phase: {field: value}} (a field of Phase, or exit.<field> of its Guard)."""
     table = PhaseTable()
+    table.rise.com_height_m = 0.575  # the erect height, as the stand-up controller resolves it
     table.forward.exit.min_time_s = 1.5
     table.lift_off.exit.min_time_s = 0.5
     for name, fields in exits.items():
@@ -206,6 +207,11 @@ def test_a_sit_back_seats_every_pad_again():
     back = _sit_back(mode, _m(3.1), TABLE)
     assert back.state == 1 and np.isnan(back.release_s).all()
     assert np.isnan(seat_loads(back, 3.2, TABLE)).all()
+
+
+def test_an_unresolved_erect_height_is_refused():
+    with pytest.raises(ValueError, match="com_height_erect"):
+        StandupStateMachine(CFG, PhaseTable(), n_pads=5, sole_rows=(0, 1))
 
 
 def test_entry_times_are_nan_until_reached():
