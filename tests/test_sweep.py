@@ -113,6 +113,37 @@ def test_seeded_random_draws_are_reproducible_and_per_run(tmp_path):
     assert abs(masses.mean() - 1.0) < 0.03 and 0.02 < masses.std() < 0.09
 
 
+def test_the_helpers_campaigns_draw_each_hand_over_the_envelope_and_share_their_helpers():
+    """helpers and helpers_interaction: 48 runs each, the same helpers (same seed), only
+    the law differs; each hand's pull drawn on its own, inside issue 21's envelope
+    (-18..25 N forward, +-25 N sideways, 0..25 N up, ramps 0.1-1 s); models: every model
+    of icub-models with the scene's frames, alone and at 15 N per hand."""
+    import icub_models
+
+    from drake_standup.config.inputs import missing_scene_frames
+
+    tangent, interaction = (expand(load_sweep(n)) for n in ("helpers", "helpers_interaction"))
+    assert len(tangent) == len(interaction) == 48
+    for a, b in zip(tangent, interaction):
+        assert a.params == b.params
+        laws = {dict(r.overrides).get("advancement.law") for r in (a, b)}
+        assert laws == {None, "interaction"}
+    left = np.array([[r.params[f"left_f{c}_N"] for c in "xyz"] for r in tangent])
+    right = np.array([[r.params[f"right_f{c}_N"] for c in "xyz"] for r in tangent])
+    for forces in (left, right):
+        assert forces[:, 0].min() >= -18.0 and forces[:, 0].max() <= 25.0
+        assert np.abs(forces[:, 1]).max() <= 25.0
+        assert forces[:, 2].min() >= 0.0 and forces[:, 2].max() <= 25.0
+        assert (forces[:, 0] < 0).sum() >= 8  # backward pulls are drawn
+    assert not np.allclose(left, right)  # each hand on its own
+    ramps = [r.params[f"{h}_ramp_s"] for r in tangent for h in ("left", "right")]
+    assert min(ramps) >= 0.1 and max(ramps) <= 1.0
+    models = expand(load_sweep("models"))
+    standing = {m for m in icub_models.get_robot_names() if not missing_scene_frames(m)}
+    assert {r.params["robot_model"] for r in models} == standing
+    assert {r.params["pull_force_N"] for r in models} == {0, 15}
+
+
 @pytest.mark.parametrize(
     "text, message",
     [
