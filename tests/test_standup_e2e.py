@@ -122,7 +122,7 @@ def test_a_hindering_pull_waits_seated_and_the_robot_stands_up_once_it_stops():
 
 @pytest.mark.parametrize(
     ("start_s", "force_N"),
-    [(1.0, 15.0), (3.5, 15.0), (4.5, 15.0), (4.6, 15.0), (5.2, 15.0), (8.0, 15.0), (3.2, 2.0)],
+    [(1.0, 18.0), (3.5, 18.0), (4.5, 18.0), (4.6, 18.0), (5.2, 18.0), (8.0, 18.0), (3.2, 2.0)],
     ids=[
         "seated",
         "in_state_2",
@@ -134,7 +134,8 @@ def test_a_hindering_pull_waits_seated_and_the_robot_stands_up_once_it_stops():
     ],
 )
 def test_a_hindering_pull_in_any_state_does_not_topple_it(start_s, force_N):
-    """Issue 13: 15 N backwards on each hand for 4 s, started before the stand-up (1.0 s),
+    """Issues 13 and 21: the authors' opposing person (18 N backwards on each hand, SPEC
+    9), abrupt (0.1 s ramps), for 4 s, started before the stand-up (1.0 s),
     inside state 2 (3.5 s: it sits back and waits), as state 3 begins (4.5 s) or inside
     it (4.6 s: it goes back onto its thighs in state 2),
     state 4 (5.2 s) or on the standing robot (8.0 s: it leans into the pull within its
@@ -145,7 +146,7 @@ def test_a_hindering_pull_in_any_state_does_not_topple_it(start_s, force_N):
 
     scenario = load_scenario(SCENARIO_DIR / "unassisted.yaml")
     scenario.human.pulls = [
-        Pull(hand=hand, start_s=start_s, duration_s=4.0, ramp_s=0.3, force_N=[-force_N, 0.0, 0.0])
+        Pull(hand=hand, start_s=start_s, duration_s=4.0, ramp_s=0.1, force_N=[-force_N, 0.0, 0.0])
         for hand in ("left", "right")
     ]
     scenario.duration_s = max(scenario.duration_s, start_s + 4.0 + 5.0)
