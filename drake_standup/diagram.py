@@ -26,7 +26,14 @@ from drake_standup.visuals import StandupVisuals
 
 CONTROLLERS = ("whole_body", "seat_hold")
 # The diagram's outputs that every run logs (the station's, the controller's, the human's).
-STATION_SIGNALS = ("robot_state", "pad_forces_W", "hand_wrenches_W", "com_W", "net_actuation")
+STATION_SIGNALS = (
+    "robot_state",
+    "pad_forces_W",
+    "hand_wrenches_W",
+    "com_W",
+    "net_actuation",
+    "standing_pull_usage",
+)
 CONTROLLER_SIGNALS = (
     "psi",
     "psi_dot",

@@ -151,6 +151,8 @@ def run_metrics(
         metrics["model_mass_kg"] = float(signals["model_mass_scale"][-1] * mass_kg)
         # How long the stand-up waited for a pull against it to stop (state machine).
         metrics["held_back_s"] = float(signals["held_back_s"][-1])
+        if "held_back_beyond_feet_s" in signals:  # signals.npz before issue 21 lack it
+            metrics["held_back_beyond_feet_s"] = float(signals["held_back_beyond_feet_s"][-1])
     torques = signals["joint_torques_Nm"]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
     return metrics

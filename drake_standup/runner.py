@@ -213,7 +213,12 @@ def collect(run: Run) -> RunResult:
         if metrics.get("standing_at_end", False) and stood:
             reason = None
         elif not stood and metrics.get("held_back_s", 0.0) > 0.0:
-            reason = "held back: hindering pull"
+            beyond = metrics.get("held_back_beyond_feet_s", 0.0)
+            reason = (
+                "held back: a pull beyond what the standing feet can hold"
+                if beyond > 0.5 * metrics["held_back_s"]
+                else "held back: hindering pull"
+            )
         else:
             reason = "stood up but was not standing at the end" if stood else "did not stand up"
     sim_time_s = root.get_time()

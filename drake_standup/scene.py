@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
+import numpy as np
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, SceneGraph
 from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.parsing import Parser
@@ -95,12 +96,10 @@ def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -
     plant.SetVelocities(plant_context, instance, 0.0 * plant.GetVelocities(plant_context, instance))
 
 
-def erect_com_height_m(scene: Scene, scenario: Scenario, posture_rad: dict[str, float]) -> float:
-    """The CoM's height above the floor in a standing posture: the joints named in
+def _standing_context(scene: Scene, scenario: Scenario, posture_rad: dict[str, float]):
+    """A plant context of the robot in a standing posture: the joints named in
     posture_rad at their values (the others as seated), the base upright at the seated
-    yaw, the soles at the height they rest at on the floor when seated. With the sagittal
-    leg angles summing to zero (hip pitch + knee + ankle pitch, as in the authors' state-4
-    posture) the soles are then flat on the floor (checked by the caller's tests)."""
+    yaw, 1 m up; and the soles' heights when seated."""
     plant = scene.plant
     instance = scene.robot.model_instance
     context = plant.CreateDefaultContext()
@@ -111,6 +110,32 @@ def erect_com_height_m(scene: Scene, scenario: Scenario, posture_rad: dict[str, 
     root = plant.GetBodyByName("root_link", instance)
     yaw = scenario.initial.base_rpy_rad[2]
     plant.SetFreeBodyPose(context, root, RigidTransform(RollPitchYaw(0.0, 0.0, yaw), [0, 0, 1]))
+    return context, soles, sole_z_seated
+
+
+def erect_com_height_m(scene: Scene, scenario: Scenario, posture_rad: dict[str, float]) -> float:
+    """The CoM's height above the floor in a standing posture (_standing_context), the
+    soles at the height they rest at on the floor when seated. With the sagittal
+    leg angles summing to zero (hip pitch + knee + ankle pitch, as in the authors' state-4
+    posture) the soles are then flat on the floor (checked by the caller's tests)."""
+    plant = scene.plant
+    context, soles, sole_z_seated = _standing_context(scene, scenario, posture_rad)
     sole_z = [frame.CalcPoseInWorld(context).translation()[2] for frame in soles]
-    com_z = plant.CalcCenterOfMassPositionInWorld(context, [instance])[2]
+    com_z = plant.CalcCenterOfMassPositionInWorld(context, [scene.robot.model_instance])[2]
     return float(com_z - min(sole_z) + min(sole_z_seated))
+
+
+def standing_offsets_m(
+    scene: Scene, scenario: Scenario, posture_rad: dict[str, float]
+) -> tuple[np.ndarray, np.ndarray]:
+    """In a standing posture (_standing_context): the hands' origins from the CoM (2 x 3,
+    left, right) and the soles' origins from it (2 x 3), world axes, m."""
+    plant = scene.plant
+    context, soles, _ = _standing_context(scene, scenario, posture_rad)
+    com = plant.CalcCenterOfMassPositionInWorld(context, [scene.robot.model_instance])
+
+    def offsets(names):
+        frames = [scene.robot.frame(plant, name) for name in names]
+        return np.array([f.CalcPoseInWorld(context).translation() - com for f in frames])
+
+    return offsets(("l_hand", "r_hand")), offsets(("l_sole", "r_sole"))

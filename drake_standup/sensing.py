@@ -7,11 +7,15 @@ Omega = J M^-1 J_h^T of the paper) and the x of the soles' heel edge.
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
 from drake_standup.caching import declare_cached
+from drake_standup.control.references import static_lean
 from drake_standup.robot import Robot
 
 
@@ -35,13 +39,55 @@ def thigh_points(robot: Robot) -> dict[str, np.ndarray]:
     return points
 
 
+@dataclass(frozen=True)
+class StandingSupport:
+    """What the standing robot can hold, for standing_pull_usage: its erect CoM height,
+    its hands' and soles' origins from the CoM (2 x 3 each, left and right; scene.
+    standing_offsets_m), how far the controller leans its CoM (forward, back, sideways:
+    lean_max_*) and each sole's CoP box (controller.foot_cop_*_m), m."""
+
+    com_height_m: float
+    hands_m: np.ndarray
+    soles_m: np.ndarray
+    lean_m: tuple[float, float, float]
+    cop_x_m: tuple[float, float]
+    cop_y_m: tuple[float, float]
+
+
+def standing_pull_usage(
+    hand_wrenches_W: np.ndarray, weight_N: float, support: StandingSupport
+) -> float:
+    """The share of what the standing robot's feet can hold that a pull needs, judged on
+    the robot standing (whatever its posture now): the hands' wrenches
+    (payloads.HAND_WRENCHES) at its standing hands give a resultant about the CoM that
+    needs the static lean d of references.static_lean at the erect height; the feet hold
+    it by leaning up to lean_m and moving the CoP to the edge of the soles' boxes (half
+    their length forward and back, half the span of both boxes sideways). 1 at the edge;
+    10 if the pull lifts the robot."""
+    F = np.asarray(hand_wrenches_W).reshape(2, 6)
+    wrench = np.concatenate(
+        [F[:, :3].sum(axis=0) + np.cross(support.hands_m, F[:, 3:]).sum(axis=0), F[:, 3:].sum(0)]
+    )
+    if weight_N - wrench[5] <= 0.0:
+        return 10.0
+    d = static_lean(wrench, support.com_height_m, weight_N, math.inf)
+    half_x = (support.cop_x_m[1] - support.cop_x_m[0]) / 2
+    span = abs(support.soles_m[0, 1] - support.soles_m[1, 1])
+    half_y = (span + support.cop_y_m[1] - support.cop_y_m[0]) / 2
+    forward, back, side = support.lean_m
+    return float(
+        max(d[0] / (forward + half_x), -d[0] / (back + half_x), abs(d[1]) / (side + half_y))
+    )
+
+
 class RobotSensing(LeafSystem):
     """Inputs robot_state [q; v], hand_wrenches_W (12: [tau_l, f_l, tau_r, f_r]).
 
     Outputs com_W (3, m), com_velocity_W (3, m/s), omega_f_W (3, m/s^2),
     heel_x_W (1, m: the front-most of the two soles' heel edges, so "CoM ahead
     of the heels" holds for both feet) and thigh_x_W (1, m: the mean x of the
-    thigh pads' centres, where the seat's support ends; NaN without pads).
+    thigh pads' centres, where the seat's support ends; NaN without pads) and, with a
+    StandingSupport, standing_pull_usage (1: standing_pull_usage of the measured pull).
 
     The CoM outputs share one cache entry that depends on robot_state only:
     the plant context is set once per new state (once per plant step), not
@@ -55,6 +101,7 @@ class RobotSensing(LeafSystem):
         robot: Robot,
         heel_points: dict[str, np.ndarray],
         thigh_points: dict[str, np.ndarray] | None = None,
+        standing: StandingSupport | None = None,
     ):
         super().__init__()
         self._plant = plant
@@ -67,6 +114,8 @@ class RobotSensing(LeafSystem):
             (plant.GetFrameByName(f, self._instance), np.asarray(p))
             for f, p in (thigh_points or {}).items()
         ]
+        self._standing = standing
+        self._g = -plant.gravity_field().gravity_vector()[2]
         nx = plant.num_multibody_states(self._instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         self._wrenches = self.DeclareVectorInputPort("hand_wrenches_W", 12)
@@ -86,6 +135,13 @@ class RobotSensing(LeafSystem):
         self.DeclareVectorOutputPort(
             "omega_f_W", 3, self._CalcOmegaF, prerequisites_of_calc={self._wrenches.ticket()}
         )
+        if standing is not None:
+            self.DeclareVectorOutputPort(
+                "standing_pull_usage",
+                1,
+                self._CalcUsage,
+                prerequisites_of_calc={self._wrenches.ticket()},
+            )
 
     def _set_plant_state(self, context: Context, check: bool) -> None:
         """The private plant context at robot_state (check: unless it is there
@@ -127,6 +183,11 @@ class RobotSensing(LeafSystem):
             for frame, p in self._thighs
         ]
         output.SetAtIndex(0, float(np.mean(xs)) if xs else np.nan)
+
+    def _CalcUsage(self, context: Context, output: BasicVector) -> None:
+        F = self._wrenches.Eval(context)
+        usage = standing_pull_usage(F, self._mass_kg * self._g, self._standing) if F.any() else 0.0
+        output.SetAtIndex(0, usage)
 
     def _CalcOmegaF(self, context: Context, output: BasicVector) -> None:
         """Omega f = J_com M^-1 sum_h J_h^T F_h (paper, Sec. II).

@@ -87,6 +87,8 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
     }
     if "push_force_W" in logs:
         signals["push_force_W"] = logs["push_force_W"]
+    if "standing_pull_usage" in logs:  # sensing.standing_pull_usage of the measured pull
+        signals["standing_pull_usage"] = logs["standing_pull_usage"][:, 0]
     if "controller_diagnostics" not in logs:  # the seat-hold benchmark: no controller
         return signals
     reference = COM_REFERENCE.unpack(logs["com_reference"])
@@ -116,5 +118,9 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
         "commanded_normal_force_N": diagnostics["commanded_normal_force_N"],
         "hindered": held[:, 0] > 0.5,
         "held_back_s": held[:, 1],
+        # A pull beyond what the standing robot's feet can hold, and how long it held
+        # the stand-up back (state_machine.py).
+        "pull_beyond_feet": held[:, 2] > 0.5,
+        "held_back_beyond_feet_s": held[:, 3],
     }
     return signals

@@ -14,7 +14,8 @@ with its mass estimate (control/model.py, control/mass.py) and the task referenc
 
 Inputs (a station's outputs of the same names, station.py): robot_state, pad_forces_W,
 seat_pad_normal_forces_N, pads_vertical_force_N, hand_wrenches_W (measured), com_W,
-com_velocity_W, omega_f_W, heel_x_W, thigh_x_W; and stand_up (1; > 0.5: start; unconnected: never),
+com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, standing_pull_usage; and stand_up (1;
+> 0.5: start; unconnected: never),
 which only the live helper has.
 Outputs: actuation; controller_diagnostics (control/controller.py: DIAGNOSTICS); psi,
 psi_dot, alpha; com_reference, x_d_W; standup_state, held_back, segment, entry_times_s;
@@ -50,6 +51,7 @@ _WIRES = [
     ("state_machine", "com_W", "", "com_W"),
     ("state_machine", "heel_x_W", "", "heel_x_W"),
     ("state_machine", "thigh_x_W", "", "thigh_x_W"),
+    ("state_machine", "standing_pull_usage", "", "standing_pull_usage"),
     ("state_machine", "pad_forces_W", "", "pad_forces_W"),
     ("state_machine", "hand_wrenches_W", "", "hand_wrenches_W"),
     ("state_machine", "stand_up", "", "stand_up"),

@@ -81,6 +81,14 @@ class GuardSignals:
     # Both hands together pulled backwards (against the stand-up) by more than
     # hindering_force_threshold_N.
     hindered: SchmittTrigger = _OFF
+    # A pull needing more than standing_pull_usage_limit of what the standing robot's
+    # feet can hold (filtered usage; the trigger).
+    pull_usage: float = 0.0
+    beyond_feet: SchmittTrigger = _OFF
+
+    def against(self) -> bool:
+        """A pull the stand-up cannot go on under: hindering, or beyond the feet."""
+        return self.hindered.on or self.beyond_feet.on
 
 
 @dataclass(frozen=True)
@@ -95,7 +103,8 @@ class StandupMode:
     x_start_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     delta_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     guards: GuardSignals = GuardSignals()
-    held_back_s: float = 0.0  # time spent waiting for a hindering pull to stop
+    held_back_s: float = 0.0  # time spent waiting for a pull against it to stop
+    held_beyond_feet_s: float = 0.0  # of which a pull beyond what the feet can hold
     # Where the CoM sat at the start: a sit-back returns there, so that the next
     # forward segment starts where the first one did.
     x_seated_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -140,6 +149,8 @@ class Measurements:
     # The x of the thigh pads' centres (NaN: not measured; a release waiting for the CoM
     # to pass them never begins).
     thigh_x: float = math.nan
+    # sensing.standing_pull_usage of the measured pull (0: not measured).
+    pull_usage: float = 0.0
     # Someone asked for the stand-up (live mode's "Stand up" button): with
     # trigger 'hands', as good as the pull.
     stand_up: bool = False
@@ -163,12 +174,13 @@ def update_guards(
     step held over the update: gain 1 - exp(-dt / tau); the first measurement starts the
     filters), then the triggers of every phase's exit."""
     if math.isnan(g.t):
-        feet, hands = tuple(m.foot_fz_N), tuple(m.hand_fx_N)
+        feet, hands, usage = tuple(m.foot_fz_N), tuple(m.hand_fx_N), m.pull_usage
     else:
         tau = cfg.force_filter_time_constant_s
         gain = 1.0 if tau <= 0 else 1.0 - math.exp(-max(m.t - g.t, 0.0) / tau)
         feet = _low_pass(g.foot_fz_N, m.foot_fz_N, gain)
         hands = _low_pass(g.hand_fx_N, m.hand_fx_N, gain)
+        (usage,) = _low_pass((g.pull_usage,), (m.pull_usage,), gain)
     off, dwell = cfg.guard_off_ratio, cfg.guard_dwell_s
 
     def trigger(trigger: SchmittTrigger, value: float, threshold: float | None):
@@ -190,6 +202,10 @@ def update_guards(
             trigger(k, min(feet), e.each_foot_force_N) for k, e in zip(g.each_foot_loaded, exits)
         ),
         hindered=g.hindered.update(-sum(hands), m.t, back_on, off * back_on, dwell),
+        pull_usage=usage,
+        beyond_feet=g.beyond_feet.update(
+            usage, m.t, cfg.standing_pull_usage_limit, off * cfg.standing_pull_usage_limit, dwell
+        ),
     )
 
 
@@ -200,12 +216,21 @@ def next_mode(
     (under a pull against the stand-up) an earlier state."""
     g = update_guards(mode.guards, m, cfg, table)
     phase = table.phase(mode.state)
-    held = mode.held_back_s
-    if g.hindered.on and phase.when_hindered != "stand" and not math.isnan(mode.guards.t):
+    against = g.against()
+    held, beyond = mode.held_back_s, mode.held_beyond_feet_s
+    if against and phase.when_hindered != "stand" and not math.isnan(mode.guards.t):
         held += m.t - mode.guards.t
-    hindered_until = m.t if g.hindered.on else mode.hindered_until_s
-    mode = dataclasses.replace(mode, guards=g, held_back_s=held, hindered_until_s=hindered_until)
-    if g.hindered.on:
+        if g.beyond_feet.on:
+            beyond += m.t - mode.guards.t
+    hindered_until = m.t if against else mode.hindered_until_s
+    mode = dataclasses.replace(
+        mode,
+        guards=g,
+        held_back_s=held,
+        held_beyond_feet_s=beyond,
+        hindered_until_s=hindered_until,
+    )
+    if against:
         if phase.when_hindered == "step_back":
             loads = np.nan_to_num(seat_loads(mode, m.t, table), nan=1.0)  # NaN: seated
             left = max(loads[_released(phase)], default=0.0)
@@ -216,7 +241,7 @@ def next_mode(
         elif phase.when_hindered == "sit_back" and not mode.stepped_back():
             return _sit_back(mode, m, table)
     mode = _begin_releases(mode, phase, m)
-    calm = not g.hindered.on and m.t - mode.hindered_until_s >= cfg.resume_after_s
+    calm = not against and m.t - mode.hindered_until_s >= cfg.resume_after_s
     if mode.state == N_STATES or not (calm and guard_holds(phase, mode, m, cfg)):
         return mode
     return _enter(mode, mode.state + 1, m, table)
@@ -395,8 +420,9 @@ class StandupStateMachine(LeafSystem):
     stand_up (1; > 0.5: go; unconnected: never), which only the live helper has.
     Outputs: mode (abstract StandupMode), standup_state (1), advances (1: the phase lets
     psi advance), segment (payloads.SEGMENT), entry_times_s (4, NaN for states not
-    reached), held_back (2: [a pull against the stand-up holds it (1/0), the time it has
-    waited so far, s]).
+    reached), held_back (4: [a backward pull holds it (1/0), the time it has waited so
+    far, s, a pull beyond the standing feet holds it (1/0), the part of that time it did,
+    s]).
     """
 
     def __init__(
@@ -421,6 +447,7 @@ class StandupStateMachine(LeafSystem):
         self._com = self.DeclareVectorInputPort("com_W", 3)
         self._heel = self.DeclareVectorInputPort("heel_x_W", 1)
         self._thigh = self.DeclareVectorInputPort("thigh_x_W", 1)
+        self._usage = self.DeclareVectorInputPort("standing_pull_usage", 1)
         self._pads = self.DeclareVectorInputPort("pad_forces_W", 3 * n_pads)
         self._hands = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         self._stand_up = self.DeclareVectorInputPort("stand_up", 1)
@@ -435,7 +462,7 @@ class StandupStateMachine(LeafSystem):
             "advances": (1, self._CalcAdvances),
             "segment": (SEGMENT.size, self._CalcSegment),
             "entry_times_s": (N_STATES, self._CalcEntryTimes),
-            "held_back": (2, self._CalcHeldBack),
+            "held_back": (4, self._CalcHeldBack),
         }
         for name, (size, calc) in vectors.items():
             self.DeclareVectorOutputPort(name, size, calc, prerequisites_of_calc=mode_only)
@@ -468,6 +495,9 @@ class StandupStateMachine(LeafSystem):
             foot_fz_N=(float(pads[left, 2]), float(pads[right, 2])),
             hand_fx_N=(float(hands[0, 3]), float(hands[1, 3])),
             stand_up=self._stand_up.HasValue(context) and self._stand_up.Eval(context)[0] > 0.5,
+            pull_usage=float(self._usage.Eval(context)[0])
+            if self._usage.HasValue(context)
+            else 0.0,
         )
 
     def _Update(self, context: Context, state: State) -> None:
@@ -488,7 +518,15 @@ class StandupStateMachine(LeafSystem):
 
     def _CalcHeldBack(self, context: Context, output: BasicVector) -> None:
         mode = self.mode(context)
-        output.SetFromVector([float(mode.guards.hindered.on), mode.held_back_s])
+        g = mode.guards
+        output.SetFromVector(
+            [
+                float(g.hindered.on),
+                mode.held_back_s,
+                float(g.beyond_feet.on),
+                mode.held_beyond_feet_s,
+            ]
+        )
 
     def _CalcContactPlan(self, context: Context, output: BasicVector) -> None:
         mode = self.mode(context)

@@ -18,6 +18,7 @@ Outputs
     pads_vertical_force_N     (1) the vertical force on all the robot's pads
     hand_wrenches_W           (12) the hands' sensors' wrenches (payloads.HAND_WRENCHES)
     com_W, com_velocity_W, omega_f_W, heel_x_W, thigh_x_W   sensing.py
+    standing_pull_usage       (1) the share of the standing feet's hold a pull needs
     push_force_W              (3) only with perturbation.pushes
 """
 
@@ -35,8 +36,8 @@ from drake_standup.contacts import ContactForceReporter
 from drake_standup.payloads import HAND_WRENCHES
 from drake_standup.perturbations import NoisyWrenchSensor, PushSource
 from drake_standup.robot import ActuatedJoints, Robot, actuated_joints
-from drake_standup.scene import Scene, add_scene
-from drake_standup.sensing import RobotSensing, heel_points, thigh_points
+from drake_standup.scene import Scene, add_scene, erect_com_height_m, standing_offsets_m
+from drake_standup.sensing import RobotSensing, StandingSupport, heel_points, thigh_points
 
 # Pad groups as metrics.json reports them (plural where there are two).
 _GROUP_LABELS = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
@@ -125,13 +126,26 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
     measured = sensor.get_output_port()
     builder.ExportOutput(measured, "hand_wrenches_W")
 
+    rise, config = scenario.phases.rise, scenario.controller
+    hands, soles = standing_offsets_m(scene, scenario, rise.posture_rad)
+    standing = StandingSupport(
+        com_height_m=rise.com_height_m or erect_com_height_m(scene, scenario, rise.posture_rad),
+        hands_m=hands,
+        soles_m=soles,
+        lean_m=(config.lean_max_forward_m, config.lean_max_back_m, config.lean_max_m),
+        cop_x_m=tuple(config.foot_cop_x_m),
+        cop_y_m=tuple(config.foot_cop_y_m),
+    )
     sensing = builder.AddNamedSystem(
-        "sensing", RobotSensing(plant, robot, heel_points(robot), thigh_points(robot))
+        "sensing",
+        RobotSensing(plant, robot, heel_points(robot), thigh_points(robot), standing),
     )
     robot_state = plant.get_state_output_port(instance)
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
     builder.Connect(measured, sensing.GetInputPort("hand_wrenches_W"))
     for name in ("com_W", "com_velocity_W", "omega_f_W", "heel_x_W", "thigh_x_W"):
+        builder.ExportOutput(sensing.GetOutputPort(name), name)
+    for name in ("standing_pull_usage",):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
 
     builder.ExportInput(plant.get_actuation_input_port(instance), "actuation")

@@ -119,3 +119,19 @@ def test_the_qp_plans_what_the_plant_does_while_the_robot_leaves_the_seat():
             errors.append(np.linalg.norm(planned - realised) / np.linalg.norm(planned))
     assert len(errors) >= 4
     assert np.median(errors) <= 0.3, np.round(errors, 2)
+
+
+def test_a_pull_beyond_the_standing_feet_waits_and_says_so():
+    """25 N forward and 25 N up per hand held from 3 s (the assistance sweep's largest
+    pull) stood the robot up into a pull its feet could not hold, and it fell at bounds
+    2.5 and 4. Now it waits seated while that pull lasts, says why, and stands up once the
+    helper lets go (at 8 s)."""
+    pull = [25.0, 0.0, 25.0]
+    scenario = _pulled(pull, pull, 3.0, 0.5, duration_s=5.0, name="assisted")
+    m = simulate(scenario, None, record=False, progress=False).metrics
+    _stands_erect(m)
+    assert m["held_back_beyond_feet_s"] > 4.0
+    assert m["state_entry_times_s"][1] > 8.0  # the stand-up began once the pull ended
+    scenario.duration_s = 7.0  # while the pull lasts: waiting, and saying why
+    m = simulate(scenario, None, record=False, progress=False).metrics
+    assert m["failure_reason"] == "held back: a pull beyond what the standing feet can hold"

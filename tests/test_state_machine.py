@@ -469,6 +469,35 @@ def test_time_held_back_accumulates_while_hindered():
     assert not mode.guards.hindered.on
 
 
+def test_a_pull_beyond_the_standing_feet_is_waited_out_as_a_hindering_one():
+    """A forward pull the standing robot's feet could not hold (standing_pull_usage above
+    its limit, through the guards' filter and trigger): seated, the stand-up does not
+    start; in state 2 it sits back; standing (state 4) it leans and goes on; the time it
+    held the stand-up back is counted apart; below the limit nothing of this."""
+    cfg = dataclasses.replace(CFG, trigger="time")
+    limit = cfg.standing_pull_usage_limit
+    helpful = (20.0, 20.0)  # forward: not hindering
+    over = dataclasses.replace(_m(3.5, hands=helpful), pull_usage=limit * 1.05)
+    under = dataclasses.replace(over, pull_usage=limit * 0.95)
+    mode = initial_mode(COM0)
+    waited = _next(mode, over, cfg)
+    assert waited.state == 1 and waited.guards.beyond_feet.on and not waited.guards.hindered.on
+    assert _next(mode, under, cfg).state == 2
+    forward = _in_state(2, 3.0)
+    sat = _next(forward, dataclasses.replace(over, t=3.2, psi=3.2), cfg)
+    assert sat.state == 1 and sat.sat_back
+    standing = _in_state(4, 3.0)
+    assert _next(standing, dataclasses.replace(over, t=8.0, psi=8.0), cfg).state == 4
+    t, held = 0.0, initial_mode(COM0)
+    for k in range(300):  # 3 s of updates: beyond the feet from 1 to 2 s
+        t = 0.01 * k
+        usage = 2 * limit if 1.0 <= t < 2.0 else 0.0
+        m = dataclasses.replace(_m(t, hands=helpful, com=COM0), pull_usage=usage)
+        held = next_mode(held, m, cfg, TABLE)
+    assert held.held_beyond_feet_s == pytest.approx(held.held_back_s)
+    assert 0.9 < held.held_beyond_feet_s < 1.2
+
+
 def test_stand_up_request_starts_like_the_pull_after_the_balance_time():
     """The live page's "Stand up" (Measurements.stand_up) with trigger 'hands' and no
     pull: state 2 once the balance time is over, not before; without the request the

@@ -80,6 +80,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "human.pulls[*].duration_s human.reactive.duration_s human.reactive.force_cap_N "
         "human.reactive.pace_mps advancement.eps advancement.psi_ddot_filter_s "
         "phases.*.segment_psi phases.*.com_height_m standup.update_period_s "
+        "standup.standing_pull_usage_limit "
         "controller.momentum_weight controller.*_time_constant_s "
         "controller.joint_limit_horizon_s controller.*friction_coefficient* "
         "controller.*_max_normal_force_N controller.torque_limit_Nm controller.help_* "

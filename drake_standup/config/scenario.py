@@ -211,6 +211,12 @@ class StandupConfig:
     # phase's when_hindered says how). 2 N per hand toppled the robot in state 2 under
     # the first threshold of 8 N (docs/design.md, "A pull against the stand-up"). N.
     hindering_force_threshold_N: float = 2.5
+    # A pull that would need more than this share of what the standing robot's feet can
+    # hold (sensing.standing_pull_usage: its lean plus the soles' CoP boxes) is answered
+    # as a hindering pull is: the stand-up waits, or sits back, until it eases. 20 N
+    # forward and up per hand (0.52) stands up at every psi_dot bound; 25 N (0.68) stood
+    # up and fell at two of four (docs/design.md, "A pull the feet cannot take"). -.
+    standing_pull_usage_limit: float = 0.6
     # After a hindering pull stops, the stand-up waits this long: the pull is over, and
     # the arms it swung back return to their posture first. s.
     resume_after_s: float = 0.5
