@@ -173,7 +173,8 @@ def test_the_readme_scenario_example_parses():
     text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
     example = text[text.index("## Scenarios") :].split("```yaml\n", 1)[1].split("```", 1)[0]
     scenario = parse_scenario(example)
-    assert scenario.phases.rise.com_height_m == 0.575
+    assert scenario.phases.rise.com_height_erect and scenario.phases.rise.com_height_m is None
+    assert scenario.phases.forward.unload_when == 0.015
     assert scenario.human.reactive.guide == "path"
 
 
