@@ -57,7 +57,7 @@ def test_a_releasing_pad_is_bounded_by_what_is_left_and_by_what_it_carries():
     assert commands.min_normal_force_N[0] == 0.0 and commands.max_normal_force_N[0] == 50.0
     np.testing.assert_array_equal(commands.min_normal_force_N[1:3], [F_MIN, F_MIN])
     np.testing.assert_array_equal(commands.max_normal_force_N[1:3], [SEAT_MAX, SEAT_MAX])
-    assert commands.seat_hold == "hinged" and not commands.thighs_held
+    assert commands.seat_hold == "hinged" and commands.thighs_hold == "free"
     # Measured above what is left: the fraction binds (0.25 x 80 = 20 < 55 + 20).
     loads = np.array([0.0, 0.25, 0.25])
     commands = contact_commands(
@@ -73,21 +73,21 @@ def test_a_releasing_pad_is_bounded_by_what_is_left_and_by_what_it_carries():
 
 
 def test_holds_follow_the_release_no_contact_is_counted_on_while_the_motion_lifts_it():
-    """(buttocks, thighs) left -> (seat hold, thighs held): the seat keeps its phase's
-    hold until the buttocks' release is over, then holds no rows; from then the thighs'
-    pitch and normal rows are held until their own release is over (a pad the QP still
-    counts on is not lifted by the plan), then neither."""
+    """(buttocks, thighs) left -> (seat hold, thighs' hold): the seat keeps its phase's
+    hold until the buttocks' release is over, then holds no rows; from then the thighs
+    are held flat (pitch and normal) while seated and by their normal while they unload
+    (a pad the QP still counts on is not lifted by the plan), then not at all."""
     cases = [
-        ((math.nan, math.nan), ("hinged", False)),  # seated
-        ((0.4, math.nan), ("hinged", False)),  # the buttocks unloading
-        ((0.0, math.nan), ("free", True)),  # the buttocks off, the thighs seated
-        ((0.0, 0.3), ("free", True)),  # the thighs unloading: still held
-        ((0.0, 0.0), ("free", False)),  # all off: the chair leaves the QP
+        ((math.nan, math.nan), ("hinged", "free")),  # seated
+        ((0.4, math.nan), ("hinged", "free")),  # the buttocks unloading
+        ((0.0, math.nan), ("free", "flat")),  # the buttocks off, the thighs seated
+        ((0.0, 0.3), ("free", "normal")),  # the thighs unloading: still held down
+        ((0.0, 0.0), ("free", "free")),  # all off: the chair leaves the QP
     ]
     for (buttocks, thighs), expected in cases:
         loads = np.array([buttocks, thighs, thighs])
         commands = contact_commands(CONFIG, loads, np.full(3, 100.0), None, "hinged")
-        assert (commands.seat_hold, commands.thighs_held) == expected, (buttocks, thighs)
+        assert (commands.seat_hold, commands.thighs_hold) == expected, (buttocks, thighs)
 
 
 def test_the_chair_leaves_the_qp_once_every_seat_pad_is_released():

@@ -36,7 +36,7 @@ from drake_standup.control.model import ControllerJoints
 from drake_standup.control.qp import ContactCommands as QpContactCommands
 from drake_standup.control.qp import ContactMap, QpSolution, WholeBodyQp
 from drake_standup.control.references import joint_values
-from drake_standup.control.schedule import CONTACTS, HOLDS, ContactCommands
+from drake_standup.control.schedule import CONTACTS, HOLDS, THIGH_HOLDS, ContactCommands
 from drake_standup.control.tasks import (
     BaseOrientationTask,
     CopCenteringTask,
@@ -69,7 +69,7 @@ class Program:
 
     qp: WholeBodyQp
     contact_index: np.ndarray  # of each of its contacts in CONTACTS
-    # (HOLDS, thighs held) -> ContactCommands'
+    # (HOLDS, THIGH_HOLDS) -> ContactCommands'
     partially_held: dict[tuple[str, bool], dict[int, np.ndarray]]
 
 
@@ -155,7 +155,7 @@ def make_program(
         contact_velocity_gain_per_s=config.contact_velocity_gain_per_s,
     )
     # The seat's held rows: all (held), all but its pitch about the hip axis (hinged:
-    # alpha_y in C), none (free); the thighs': their pitch and normal, or none.
+    # alpha_y in C), none (free).
     seat = [c for c, spec in enumerate(contacts) if spec.frame == "seat"]
     thighs = [c for c, spec in enumerate(contacts) if spec.frame in ("l_thigh", "r_thigh")]
     hinged = np.ones(WRENCH_SIZE, dtype=bool)
@@ -165,15 +165,17 @@ def make_program(
         "hinged": hinged,
         "free": np.zeros(WRENCH_SIZE, dtype=bool),
     }
-    # A flat thigh on the chair: it neither sinks nor pitches (alpha_y, a_z in C).
-    normal = np.zeros(WRENCH_SIZE, dtype=bool)
-    normal[[1, NORMAL]] = True
+    # A thigh on the chair does not sink (a_z in C); seated flat, it does not pitch
+    # either (alpha_y).
+    thigh_rows = {hold: np.zeros(WRENCH_SIZE, dtype=bool) for hold in THIGH_HOLDS}
+    thigh_rows["normal"][NORMAL] = True
+    thigh_rows["flat"][[1, NORMAL]] = True
     partially_held = {}
     for hold in HOLDS:
-        for thighs_held in (False, True):
+        for thighs_hold in THIGH_HOLDS:
             held = {c: rows[hold] for c in seat}
-            held.update({c: normal if thighs_held else rows["free"] for c in thighs})
-            partially_held[(hold, thighs_held)] = held
+            held.update({c: thigh_rows[thighs_hold] for c in thighs})
+            partially_held[(hold, thighs_hold)] = held
     return Program(
         qp=qp,
         contact_index=np.array([CONTACTS.index(spec.frame) for spec in contacts]),
@@ -267,7 +269,7 @@ class WholeBodyController(LeafSystem):
                 QpContactCommands(
                     commands.min_normal_force_N[index],
                     commands.max_normal_force_N[index],
-                    program.partially_held[(commands.seat_hold, commands.thighs_held)],
+                    program.partially_held[(commands.seat_hold, commands.thighs_hold)],
                 ),
             )
         solution = program.qp.solve(terms, references, self._last[1])

@@ -11,10 +11,10 @@ both soles (6-D). The phase table (phases.py) says when each seat pad's load is 
     sole                       f_z in [f_min, f_max_foot]
     seat hold                  the phase's seat_hold (seat_hold_sat_back after a sit-back)
                                until the buttocks' release is over; no rows then
-    thighs held                their pitch and normal rows once the buttocks are off,
-                               until the thighs' own release is over: the QP counts on
-                               their wrench, so it may not plan motions that lift them
-                               while they still carry load
+    thighs held                once the buttocks are off, while seated: flat (pitch and
+                               normal); while they unload: their normal; released: none.
+                               The QP counts on their wrench, so it may not plan motions
+                               that lift them while they still carry load
 
 F_0 is what the controller commanded the pad when its release began (the schedule's
 memory: a pad lifting off cannot push). The measured bound: the thighs are forces the QP
@@ -41,6 +41,7 @@ CONTACTS = ("seat", "l_thigh", "r_thigh", "l_sole", "r_sole")
 CHAIR = slice(0, 3)
 SOLES = slice(3, 5)
 HOLDS = ("held", "hinged", "free")
+THIGH_HOLDS = ("free", "normal", "flat")
 
 
 @dataclass(frozen=True)
@@ -51,7 +52,8 @@ class ContactCommands:
     min_normal_force_N: np.ndarray  # (5,) f_z bounds, N
     max_normal_force_N: np.ndarray  # (5,)
     seat_hold: str  # HOLDS: the seat's rows held (all, all but the hip pitch, none)
-    thighs_held: bool = False  # the thighs' normal rows held
+    # The thighs' rows held: none (free), their normal (normal) or their pitch too (flat).
+    thighs_hold: str = "free"
 
 
 def next_unload_from(
@@ -77,6 +79,11 @@ def contact_commands(
     releasing = np.isfinite(loads)
     chair = bool(np.any(~releasing | (loads > 0.0)))
     seat_off = bool(releasing[0] and loads[0] <= 0.0)  # the buttocks' release is over
+    thighs_hold = "free"
+    if seat_off and not releasing[1]:
+        thighs_hold = "flat"
+    elif seat_off and loads[1] > 0.0:
+        thighs_hold = "normal"
     low = np.full(len(CONTACTS), config.min_normal_force_N)
     high = np.empty(len(CONTACTS))
     high[CHAIR] = config.seat_max_normal_force_N
@@ -93,7 +100,7 @@ def contact_commands(
         min_normal_force_N=low,
         max_normal_force_N=high,
         seat_hold="free" if seat_off else seat_hold,
-        thighs_held=bool(seat_off and not (releasing[1] and loads[1] <= 0.0)),
+        thighs_hold=thighs_hold,
     )
 
 
