@@ -13,7 +13,7 @@ import msgpack
 import numpy as np
 import pytest
 
-from drake_standup.config import SCENARIO_DIR, HumanConfig, Scenario, load_scenario
+from drake_standup.config import SCENARIO_DIR, HumanConfig, Push, Scenario, load_scenario
 from drake_standup.diagram import build_diagram
 from drake_standup.human import HumanWrenchSource
 from drake_standup.live import (
@@ -253,12 +253,11 @@ def test_a_helpful_slider_pull_advances_psi_and_a_backward_one_does_not():
 
 
 class _Toppling(_Pulling):
-    """A helper who pulls 3 N back on each hand, with the hindering hold switched off
-    (toppling_scenario: the robot then falls in state 2), lets go and clicks Reset
-    once the console says it fell."""
+    """A helper who does not pull while a shove topples the robot (toppling_scenario),
+    and clicks Reset once the console says it fell."""
 
     def __init__(self, scenario):
-        super().__init__(scenario, (-3.0, 0.0))
+        super().__init__(scenario, (0.0, 0.0))
         self.lines = []
         self._report = self.lines.append
         self.reset_at = None
@@ -272,12 +271,16 @@ class _Toppling(_Pulling):
 
 
 def _toppling_scenario(duration_s: float):
-    """The quick scenario with the hindering hold off (a threshold no pull reaches): 3 N
-    back per hand then topples the robot in state 2 (measured), a fall to recover from."""
+    """The quick scenario with a 250 N shove on the chest at 0.8-1.1 s (75 N s, eight
+    times what the feet recover from): a fall to recover from. (Until issue 21, 3 N
+    back per hand with the hindering hold off toppled the robot in state 2; it no
+    longer does.)"""
     scenario = _quick("time")
     scenario.duration_s = duration_s
     scenario.simulator.target_realtime_rate = 0.0
-    scenario.standup.hindering_force_threshold_N = 1.0e3
+    scenario.perturbation.pushes = [
+        Push(body="chest", start_s=0.8, duration_s=0.3, force_N=[250.0, 0.0, 0.0])
+    ]
     return scenario
 
 
@@ -298,15 +301,15 @@ def test_a_live_run_goes_on_after_a_fall_and_reset_stands_the_robot_up_again():
 
 @pytest.mark.slow
 def test_a_fall_no_reset_undid_is_the_runs_failure_reason():
-    """The same toppling pull, nobody clicking Reset: the run goes on to its end and
+    """The same shove, nobody clicking Reset: the run goes on to its end and
     metrics.json's failure_reason is the fall the console reported."""
     scenario = _toppling_scenario(2.0)
-    session = _Pulling(scenario, (-3.0, 0.0))
+    session = _Pulling(scenario, (0.0, 0.0))
     lines = []
     session._report = lines.append
     result = run_session(scenario, session)
     assert result.metrics["sim_time_s"] == pytest.approx(2.0)
-    assert result.metrics["failure_reason"].startswith("fall: root_link height")
+    assert result.metrics["failure_reason"].startswith("fall: root_link")
     assert lines == [f"{result.metrics['failure_reason']}; Reset puts the robot back on the chair"]
 
 

@@ -102,9 +102,10 @@ def test_psi_equals_time_with_advancement_disabled():
 
 
 def test_the_default_standing_height_is_the_erect_posture():
-    """phases.rise.com_height_m is the CoM height of the authors' state-4 posture
-    with the soles flat (forward kinematics), and that posture has flat soles: the
-    sagittal leg angles sum to zero, so each sole's z axis is vertical."""
+    """The rise ends, by default, at the CoM height of the authors' state-4 posture
+    with the soles flat (forward kinematics: phases.rise.com_height_erect, resolved per
+    robot), 0.575 m on iCubGazeboV2_5, and that posture has flat soles: the sagittal leg
+    angles sum to zero, so each sole's z axis is vertical."""
     from pydrake.systems.framework import DiagramBuilder
 
     from drake_standup.config import Scenario
@@ -117,7 +118,8 @@ def test_the_default_standing_height_is_the_erect_posture():
         legs = [posture[f"{side}_{joint}"] for joint in ("hip_pitch", "knee", "ankle_pitch")]
         assert abs(sum(legs)) < 1e-9
     height = erect_com_height_m(scene, scenario, posture)
-    assert scenario.phases.rise.com_height_m == pytest.approx(height, abs=1e-3)
+    assert scenario.phases.rise.com_height_erect and scenario.phases.rise.com_height_m is None
+    assert height == pytest.approx(0.575, abs=1e-3)
     # Straighter knees stand higher; a crouch lower (monotone in the knee).
     straighter = dict(posture, l_knee=-0.05, r_knee=-0.05, l_hip_pitch=0.05, r_hip_pitch=0.05)
     assert erect_com_height_m(scene, scenario, straighter) > height
