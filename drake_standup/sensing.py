@@ -164,24 +164,19 @@ class RobotSensing(LeafSystem):
 
         return calc
 
-    def _CalcHeelX(self, context: Context, output: BasicVector) -> None:
+    def _points_x(self, context: Context, points: list) -> list[float]:
+        """The world x of each (frame, point in it) at robot_state."""
         self._set_plant_state(context, check=True)
         plant, c = self._plant, self._context
         world = plant.world_frame()
-        xs = [
-            plant.CalcPointsPositions(c, frame, p.reshape(3, 1), world)[0, 0]
-            for frame, p in self._heels
-        ]
+        return [plant.CalcPointsPositions(c, f, p.reshape(3, 1), world)[0, 0] for f, p in points]
+
+    def _CalcHeelX(self, context: Context, output: BasicVector) -> None:
+        xs = self._points_x(context, self._heels)
         output.SetAtIndex(0, max(xs) if xs else np.nan)
 
     def _CalcThighX(self, context: Context, output: BasicVector) -> None:
-        self._set_plant_state(context, check=True)
-        plant, c = self._plant, self._context
-        world = plant.world_frame()
-        xs = [
-            plant.CalcPointsPositions(c, frame, p.reshape(3, 1), world)[0, 0]
-            for frame, p in self._thighs
-        ]
+        xs = self._points_x(context, self._thighs)
         output.SetAtIndex(0, float(np.mean(xs)) if xs else np.nan)
 
     def _CalcUsage(self, context: Context, output: BasicVector) -> None:
