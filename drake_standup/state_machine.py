@@ -269,7 +269,7 @@ def released_for_s(mode: StandupMode, phase: Phase, t: float) -> float:
     """How long the release of every pad group phase unloads has been going on at t (inf:
     it unloads none; NaN: one has not begun)."""
     since = [t - mode.release_s[k] for k, pads in enumerate(SEAT_PADS) if pads in phase.unload]
-    return min(since, default=math.inf)
+    return math.nan if any(map(math.isnan, since)) else min(since, default=math.inf)
 
 
 def guard_holds(phase: Phase, mode: StandupMode, m: Measurements, cfg: StandupConfig) -> bool:

@@ -22,6 +22,7 @@ from drake_standup.state_machine import (
     _sit_back,
     initial_mode,
     next_mode,
+    released_for_s,
     seat_loads,
     update_guards,
 )
@@ -199,6 +200,19 @@ def test_the_buttocks_release_waits_for_the_com_to_pass_the_thigh_pads():
     assert blind.release_s == mode.release_s  # begun releases stay begun
     unseen = _enter(initial_mode(COM0), 2, _m(3.0, thigh_x=math.nan), TABLE)
     assert math.isnan(_next(unseen, _m(t, thigh_x=math.nan), CFG).release_s[0])
+
+
+def test_a_phase_releasing_two_pad_groups_is_released_once_both_have_begun():
+    """released_for_s over both groups: the shorter release, or NaN (not released)
+    while either has not begun, whichever group that is."""
+    both = dataclasses.replace(PhaseTable().lift_off, unload=["buttocks", "thighs"])
+    mode = initial_mode(COM0)
+    for release in ((math.nan, 1.0), (1.0, math.nan)):
+        assert math.isnan(released_for_s(dataclasses.replace(mode, release_s=release), both, 3.0))
+    begun = dataclasses.replace(mode, release_s=(1.0, 2.0))
+    assert released_for_s(begun, both, 3.0) == 1.0
+    none = dataclasses.replace(both, unload=[])
+    assert released_for_s(mode, none, 3.0) == math.inf
 
 
 def test_a_sit_back_seats_every_pad_again():

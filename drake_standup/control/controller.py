@@ -70,7 +70,7 @@ class Program:
     qp: WholeBodyQp
     contact_index: np.ndarray  # of each of its contacts in CONTACTS
     # (HOLDS, THIGH_HOLDS) -> ContactCommands'
-    partially_held: dict[tuple[str, bool], dict[int, np.ndarray]]
+    partially_held: dict[tuple[str, str], dict[int, np.ndarray]]
 
 
 def make_program(

@@ -58,8 +58,8 @@ def contact_specs(
     foot_box = {"cop_x_m": tuple(config.foot_cop_x_m), "cop_y_m": tuple(config.foot_cop_y_m)}
     return [
         ContactSpec("seat", **friction, **seat_box, hold_point_m=tuple(p_SeatHinge.tolist())),
-        # Held (their pitch and normal rows, control/schedule.py) while the buttocks are
-        # off the seat and the thighs still on it: the QP counts on their wrench then.
+        # Held once the buttocks are off the seat, while the thighs carry load (flat while
+        # seated, by their normal while they unload: control/schedule.py).
         ContactSpec("l_thigh", **friction, **thigh_box),
         ContactSpec("r_thigh", **friction, **thigh_box),
         ContactSpec("l_sole", **friction, **foot_box),
