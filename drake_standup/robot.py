@@ -10,7 +10,8 @@ What this module does to the published URDF, in order:
      adds each back as a FixedOffsetFrame on its nearest kept ancestor, so
      every named frame survives while the tree Drake integrates shrinks to
      about 40 bodies (same mass matrix, CoM and frame poses; tests check it).
-  4. Adds a JointActuator per revolute joint with the scenario's effort limit.
+  4. Adds a JointActuator per revolute joint with the scenario's effort limit and,
+     if asked, the motor's rotor inertia and gear ratio (MOTOR_INERTIAS).
 """
 
 import copy
@@ -48,6 +49,39 @@ from drake_standup.config.scenario import EFFORT_LIMIT_NM
 from drake_standup.meshes import cache_dir, converted_obj
 
 DEFAULT_MODEL = "iCubGazeboV2_5"
+
+# The motors of the authors' controller model (SPEC 9): gear ratio 100 on every joint;
+# rotor inertia 0.0827e-4 kg m^2 on the legs and torso pitch/roll, 0.0585e-4 on torso yaw
+# and the arms. Drake reflects it as ratio^2 x rotor on the joint (0.0827 and 0.0585 kg m^2):
+# diagonal, where the authors' model also couples the shoulder's and torso's tendon-driven
+# joints. Joints the authors did not list (neck, wrists) keep none.
+MOTOR_GEAR_RATIO = 100.0
+MOTOR_INERTIAS: dict[str, float] = {
+    **{
+        f"{side}_{joint}": 0.0827e-4
+        for side in "lr"
+        for joint in ("hip_pitch", "hip_roll", "hip_yaw", "knee", "ankle_pitch", "ankle_roll")
+    },
+    "torso_pitch": 0.0827e-4,
+    "torso_roll": 0.0827e-4,
+    "torso_yaw": 0.0585e-4,
+    **{
+        f"{side}_{joint}": 0.0585e-4
+        for side in "lr"
+        for joint in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
+    },
+}
+REFLECTED_INERTIA = ("none", "all", "real_robots")
+
+
+def reflects_motor_inertia(setting: str, model_name: str) -> bool:
+    """Whether robot.reflected_inertia (REFLECTED_INERTIA) turns it on for this model:
+    real_robots means every model but the Gazebo ones, which model no motors."""
+    if setting not in REFLECTED_INERTIA:
+        raise ValueError(
+            f"robot.reflected_inertia: '{setting}'; accepted: none | all | real_robots"
+        )
+    return setting == "all" or (setting == "real_robots" and "Gazebo" not in model_name)
 
 
 class ModelError(ValueError):
@@ -318,11 +352,15 @@ def add_icub(
     pd_gains: tuple[float, float] | None = None,
     contact: ContactModel | None = None,
     visual_max_faces: int = 1000,
+    motor_inertia: bool = False,
 ) -> Robot:
     """Adds the iCub to plant (before Finalize) and returns its handles.
 
     pd_gains (Kp [N m/rad], Kd [N m s/rad]) gives every joint Drake's built-in
-    implicit joint PD; None leaves the actuators pure torque sources.
+    implicit joint PD; None leaves the actuators pure torque sources. motor_inertia:
+    the actuators of MOTOR_INERTIAS' joints get their rotor inertia and gear ratio, so
+    that the plant's mass matrix (and any model of the same plant) has the reflected
+    inertia on their diagonal.
     """
     prepared = prepare_urdf(
         model_name, reduce=reduce, visuals=visuals, visual_max_faces=visual_max_faces
@@ -348,6 +386,9 @@ def add_icub(
         if isinstance(joint, RevoluteJoint):
             joint_names.append(joint.name())
             actuator = plant.AddJointActuator(joint.name(), joint, effort_limit_Nm)
+            if motor_inertia and joint.name() in MOTOR_INERTIAS:
+                actuator.set_default_rotor_inertia(MOTOR_INERTIAS[joint.name()])
+                actuator.set_default_gear_ratio(MOTOR_GEAR_RATIO)
             if pd_gains is not None:
                 kp, kd = pd_gains
                 actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))

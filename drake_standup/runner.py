@@ -25,6 +25,7 @@ from drake_standup.control.controller import DIAGNOSTICS
 from drake_standup.diagram import StandupDiagram, build_diagram
 from drake_standup.metrics import run_metrics
 from drake_standup.perturbations import apply_model_errors
+from drake_standup.robot import reflects_motor_inertia
 from drake_standup.scene import set_seated_state
 from drake_standup.signals import make_signals
 
@@ -229,8 +230,15 @@ def collect(run: Run) -> RunResult:
         "wall_time_s": run.wall_time_s,
         "realtime_factor": sim_time_s / run.wall_time_s if run.wall_time_s > 0 else None,
     }
+    model = scenario.robot.model
     metrics = (
-        head | metrics | {"build_time_s": run.build_time_s, "robot_model": scenario.robot.model}
+        head
+        | metrics
+        | {
+            "build_time_s": run.build_time_s,
+            "robot_model": model,
+            "reflected_inertia": reflects_motor_inertia(scenario.robot.reflected_inertia, model),
+        }
     )
     return RunResult(
         metrics,

@@ -17,7 +17,7 @@ from drake_standup.config import Scenario, chair_file
 from drake_standup.config.inputs import add_sdf
 from drake_standup.perturbations import scale_friction
 from drake_standup.resources import model_file
-from drake_standup.robot import Robot, add_icub, set_joint_positions
+from drake_standup.robot import Robot, add_icub, reflects_motor_inertia, set_joint_positions
 
 
 class _NoDeformableHalfSpaceWarning(logging.Filter):
@@ -55,6 +55,9 @@ def add_scene(
         effort_limit_Nm=scenario.robot.effort_limit_Nm,
         pd_gains=pd_gains,
         visual_max_faces=scenario.robot.visual_max_faces,
+        motor_inertia=reflects_motor_inertia(
+            scenario.robot.reflected_inertia, scenario.robot.model
+        ),
     )
     parser = Parser(plant)
     (floor,) = add_sdf(parser, model_file("floor.sdf"))

@@ -58,6 +58,14 @@ BAD = {
     "nan": ("duration_s: .nan\n", "duration_s"),
     "nested_inf": ("initial:\n  base_xyz_m: [0.0, .inf, 0.4]\n", "initial.base_xyz_m[1]"),
     "unknown_model": ("robot:\n  model: NoSuchRobot\n", "robot.model"),
+    "reflected_inertia_yaml_boolean": (
+        "robot:\n  reflected_inertia: on\n",
+        "robot.reflected_inertia",
+    ),
+    "reflected_inertia_unknown": (
+        "robot:\n  reflected_inertia: motors\n",
+        "robot.reflected_inertia",
+    ),
     "nan_in_drake_config": ("plant:\n  time_step: .nan\n", "plant.time_step"),
     "controller_faster_than_plant": (
         "plant:\n  time_step: 0.005\ncontroller_period_s: 0.001\n",

@@ -413,3 +413,79 @@ def test_seated_pad_rests_on_its_surface(seated, pad):
         assert abs(lowest - seat_top) <= PAD_GAP_TOL_M, f"{pad} lowest z = {lowest:.4f}"
         centre = X_WG.translation()[:2]
         assert np.all(centre >= lo + chair_xyz[:2]) and np.all(centre <= hi + chair_xyz[:2])
+
+
+# --- Motor reflected inertia ---------------------------------------------------------
+
+# The authors' motor model (SPEC 9), written out here: gear ratio 100; rotor inertia
+# 0.0827e-4 kg m^2 on the legs and torso pitch/roll, 0.0585e-4 on torso yaw and the arms.
+_LEGS_TORSO = [
+    f"{side}_{joint}"
+    for side in "lr"
+    for joint in ("hip_pitch", "hip_roll", "hip_yaw", "knee", "ankle_pitch", "ankle_roll")
+] + ["torso_pitch", "torso_roll"]
+_ARMS_YAW = ["torso_yaw"] + [
+    f"{side}_{joint}"
+    for side in "lr"
+    for joint in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
+]
+
+
+def _mass_matrix(motor_inertia: bool) -> tuple[np.ndarray, MultibodyPlant]:
+    plant = MultibodyPlant(0.0)
+    add_icub(plant, visuals=False, contact=ContactModel(), motor_inertia=motor_inertia)
+    plant.Finalize()
+    context = plant.CreateDefaultContext()
+    q = plant.GetPositions(context)
+    q[7:] += 0.1 * np.random.default_rng(3).standard_normal(len(q) - 7)  # joints only
+    plant.SetPositions(context, q)
+    return plant.CalcMassMatrix(context), plant
+
+
+def test_reflected_inertia_is_ratio_squared_times_rotor_on_the_motor_joints():
+    """M with the motors minus M without: 100^2 x the rotor inertia on each listed
+    joint's diagonal entry, nothing anywhere else (neck, wrists, base, off-diagonal)."""
+    M_off, _ = _mass_matrix(False)
+    M_on, plant = _mass_matrix(True)
+    expected = np.zeros(plant.num_velocities())
+    for names, rotor in ((_LEGS_TORSO, 0.0827e-4), (_ARMS_YAW, 0.0585e-4)):
+        for name in names:
+            expected[plant.GetJointByName(name).velocity_start()] = 100.0**2 * rotor
+    assert np.count_nonzero(expected) == len(_LEGS_TORSO) + len(_ARMS_YAW) == 23
+    np.testing.assert_allclose(M_on - M_off, np.diag(expected), atol=1e-12)
+
+
+def test_reflected_inertia_setting_by_model():
+    from drake_standup.robot import reflects_motor_inertia
+
+    assert not reflects_motor_inertia("none", "iCubGenova04")
+    assert reflects_motor_inertia("all", "iCubGazeboV2_5")
+    assert reflects_motor_inertia("real_robots", "iCubGenova04")
+    assert not reflects_motor_inertia("real_robots", "iCubGazeboV2_7")
+    with pytest.raises(ValueError, match="robot.reflected_inertia.*none \\| all \\| real_robots"):
+        reflects_motor_inertia("on", "iCubGenova04")
+
+
+@pytest.mark.parametrize(
+    ("model", "setting", "expected"),
+    [
+        ("iCubGenova04", None, True),  # the default: real_robots
+        ("iCubGazeboV2_5", None, False),
+        ("iCubGazeboV2_5", "all", True),
+        ("iCubGenova04", "none", False),
+    ],
+)
+def test_scene_gives_the_motors_their_inertia_per_setting(model, setting, expected):
+    """The scenario's plant (which the controller's model is) has the knee's motor
+    reflected inertia, 100^2 x 0.0827e-4 kg m^2, exactly where the setting says."""
+    from drake_standup.config import load_scenario
+    from drake_standup.station import make_station
+
+    overrides = [("robot.model", model)]
+    if setting is not None:
+        overrides.append(("robot.reflected_inertia", setting))
+    plant = make_station(load_scenario(None, overrides)).plant
+    knee = plant.GetJointActuatorByName("l_knee")
+    context = plant.CreateDefaultContext()
+    reflected = knee.rotor_inertia(context) * knee.gear_ratio(context) ** 2
+    assert reflected == pytest.approx(0.0827 if expected else 0.0, abs=1e-12)

@@ -64,6 +64,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (("left", "right"), "human.pulls[*].hand"),
     (("velocity", "path"), "human.reactive.guide"),
     (("tangent", "interaction"), "advancement.law"),
+    (("none", "all", "real_robots"), "robot.reflected_inertia"),
     (("hands", "time"), "standup.trigger"),
     (SEAT_HOLDS, "phases.*.seat_hold phases.*.seat_hold_sat_back"),
     (SEAT_PADS, "phases.*.unload[*]"),

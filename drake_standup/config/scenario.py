@@ -56,6 +56,12 @@ class RobotConfig:
     # viewer, ~0.15 MB per simulated second of animation, plus the meshes: at
     # 1000 faces they take ~1.3 MB and a 15 s recording stays under 8 MB.
     visual_max_faces: int = 1000
+    # The motors' reflected inertia (gear ratio^2 x rotor inertia on each actuated
+    # joint, robot.py MOTOR_INERTIAS), in the plant and the controller's model alike:
+    # none | all | real_robots (every model but the Gazebo ones). As the authors had it
+    # (SPEC 9: on for the real robots, off in Gazebo); the convergence study found it
+    # cheaper per step and converged at a larger step (docs/performance.md).
+    reflected_inertia: str = "real_robots"
 
 
 @dataclass
@@ -323,12 +329,12 @@ class Scenario:
     # Simulated time. s.
     duration_s: float = 5.0
     # Drake's own plant settings: discrete 'similar' (SPEC 5: 'lagged' and
-    # 'similar' ran 1.4-2.2x faster than real time, SAP 0.6x), stepped at 4 ms:
-    # the largest step of the convergence study (python -m
-    # drake_standup.convergence, README "Performance") at which every scenario
-    # stays within issue 11's bounds of its 1 ms run, or no further from a
-    # 0.5 ms run than the 1 ms run is. 1 ms: plant.time_step and
-    # controller_period_s both 0.001.
+    # 'similar' ran 1.4-2.2x faster than real time, SAP 0.6x), stepped at 4 ms for
+    # speed: in the convergence study (python -m drake_standup.convergence,
+    # docs/performance.md) 4 ms keeps every stand-up time within 0.04 s of 1 ms but
+    # fails the assisted CoM path's timing and, without motor inertia, the seated
+    # load split; 2 ms with robot.reflected_inertia all passes strictly. 1 ms:
+    # plant.time_step and controller_period_s both 0.001.
     plant: MultibodyPlantConfig = field(
         default_factory=lambda: MultibodyPlantConfig(
             time_step=0.004,
