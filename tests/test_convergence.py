@@ -255,6 +255,11 @@ def test_study_cases_and_cache_keys():
     assert case_inputs(cases[0], "duration_s: 5.0\n", 5.0) == a
     assert case_inputs(cases[0], "duration_s: 6.0\n", 5.0)["hash"] != a["hash"]
     assert case_inputs(cases[0], "duration_s: 5.0\n", 4.0)["hash"] != a["hash"]
+    # --set is an input (its runs are not another study's), and absent without one.
+    assert "overrides" not in a
+    with_set = case_inputs(cases[0], "duration_s: 5.0\n", 5.0, [("robot.reflected_inertia", "all")])
+    assert with_set["overrides"] == [["robot.reflected_inertia", "all"]]
+    assert with_set["hash"] != a["hash"]
 
 
 def _write_run(run_dir, run: RunData, inputs: dict | None) -> None:
@@ -293,6 +298,9 @@ def test_reports_name_every_run_and_the_choice(tmp_path):
     assert len(rows) == 4
     assert "**no**: com_deviation" in rows[-1]
     assert "Chosen: plant 2 ms, controller" in text
+    assert "--set" not in text
+    named = markdown(records, choice, overrides=[("robot.reflected_inertia", "all")])
+    assert named.splitlines()[0] == "Every run with `robot.reflected_inertia=all` (`--set`)."
     path = tmp_path / "convergence.png"
     draw_figure(records, path)
     assert path.stat().st_size > 10_000
@@ -306,6 +314,17 @@ def test_bad_options_are_one_error_line_and_exit_2(argv, tmp_path, capsys):
     assert main(["--out", str(tmp_path), *argv]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: --")
+    assert not (tmp_path / "runs").exists()
+
+
+@pytest.mark.parametrize(
+    ("setting", "key"),
+    [("robot.reflected_inertia=bogus", "robot.reflected_inertia"), ("nosuch.key=1", "nosuch")],
+)
+def test_a_bad_set_is_one_error_line_naming_the_key_before_any_run(setting, key, tmp_path, capsys):
+    assert main(["--out", str(tmp_path), "--scenarios", "seated", "--set", setting]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: ") and key in err[0]
     assert not (tmp_path / "runs").exists()
 
 

@@ -62,8 +62,11 @@ def scenario_duration_s(name: str, text: str) -> float:
     return SEATED_DURATION_S if name == "seated" else parse_scenario(text, name).duration_s
 
 
-def case_inputs(case: Case, scenario_text: str, duration_s: float) -> dict:
-    """What a run's result depends on (bar the code), and its hash."""
+def case_inputs(
+    case: Case, scenario_text: str, duration_s: float, overrides: list | tuple = ()
+) -> dict:
+    """What a run's result depends on (bar the code), and its hash; overrides: the
+    study's --set (key path, value) pairs, applied to every run."""
     inputs = {
         "scenario": case.scenario,
         "scenario_sha256": hashlib.sha256(scenario_text.encode()).hexdigest(),
@@ -71,5 +74,7 @@ def case_inputs(case: Case, scenario_text: str, duration_s: float) -> dict:
         "plant_time_step_s": case.step_s,
         "controller_period_s": case.controller_period_s,
     }
+    if overrides:  # absent otherwise: runs cached before --set keep their hash
+        inputs["overrides"] = [[path, value] for path, value in overrides]
     inputs["hash"] = hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:16]
     return inputs

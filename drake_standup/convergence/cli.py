@@ -1,7 +1,7 @@
 """Time-step convergence study (issue 11): how coarse may the plant and controller step?
 
 drake-standup convergence [--out DIR] [--workers N] [--scenarios NAME ...]
-    [--steps-ms H ...] [--fresh] [--docs DIR]
+    [--steps-ms H ...] [--set KEY=VALUE ...] [--fresh] [--docs DIR]
 
 A study, not a test. It simulates scenarios/NAME.yaml (assisted, unassisted,
 lateral and seated by default) with the plant stepped at each of 0.5, 1, 2, 4, 5, 8
@@ -25,7 +25,8 @@ scenario's text, duration, plant step and controller period) are unchanged;
 one, use --fresh. At the end: OUT/convergence.json (every run's numbers, errors,
 pass or fail per bound, and the choice), OUT/convergence.md (the tables for the
 README) and OUT/convergence.png (the errors over their bounds and the speed
-against the step).
+against the step). --set changes every run's scenario alike (e.g.
+robot.reflected_inertia=all: does the motors' inertia let a larger step converge?).
 """
 
 from __future__ import annotations
@@ -36,8 +37,8 @@ import shutil
 import sys
 from pathlib import Path
 
-from drake_standup.arguments import OneLineErrorParser
-from drake_standup.config import SCENARIO_DIR, ScenarioError
+from drake_standup.arguments import OneLineErrorParser, parse_set
+from drake_standup.config import SCENARIO_DIR, ScenarioError, parse_scenario
 from drake_standup.config.inputs import check_output_dir
 from drake_standup.convergence.cases import SCENARIOS, STEPS_MS
 from drake_standup.convergence.report import fmt
@@ -75,6 +76,13 @@ def main(argv: list[str] | None = None, prog: str = "python -m drake_standup.con
         help="plant steps, ms; 1 ms is the reference, a smaller one checks it "
         "(default: %(default)s)",
     )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a scenario key set in every run (YAML value; repeatable)",
+    )
     parser.add_argument("--fresh", action="store_true", help="simulate every run again")
     parser.add_argument(
         "--docs", type=Path, default=None, help="also copy convergence.md and .png into DIR"
@@ -104,9 +112,23 @@ def main(argv: list[str] | None = None, prog: str = "python -m drake_standup.con
         return 2
     scenarios = list(dict.fromkeys(args.scenarios))
     steps = sorted(set(args.steps_ms))
+    try:  # a bad --set fails now, on every scenario, not in the workers
+        overrides = [parse_set(text) for text in args.set]
+        for name in scenarios:
+            path = SCENARIO_DIR / f"{name}.yaml"
+            parse_scenario(path.read_text(), f"scenarios/{name}.yaml", overrides)
+    except ScenarioError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
     try:
         result = run_study(
-            scenarios, steps, args.out, workers=args.workers, address=args.address, fresh=args.fresh
+            scenarios,
+            steps,
+            args.out,
+            workers=args.workers,
+            address=args.address,
+            fresh=args.fresh,
+            overrides=overrides,
         )
     except OSError as err:
         print(f"error: {err}", file=sys.stderr)

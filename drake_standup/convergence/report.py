@@ -25,9 +25,19 @@ def _crossings_total(crossings: dict | None) -> int | None:
     return sum(up + down for up, down in crossings.values())
 
 
-def markdown(records: list[dict], choice: dict | None, wall_s: float | None = None) -> str:
-    """convergence.md: the per-run table, the per-configuration summary, the choice."""
-    lines = [
+def markdown(
+    records: list[dict],
+    choice: dict | None,
+    wall_s: float | None = None,
+    overrides: list | tuple = (),
+) -> str:
+    """convergence.md: the per-run table, the per-configuration summary, the choice;
+    overrides: the study's --set pairs, named above the tables."""
+    lines = []
+    if overrides:
+        settings = ", ".join(f"`{path}={value}`" for path, value in overrides)
+        lines += [f"Every run with {settings} (`--set`).", ""]
+    lines += [
         "Each run against the same scenario's 1 ms run (plant and controller at 1 ms). "
         "Bounds (issue 11): stand-up time within max(2%, 0.03 s), state entries within "
         "0.05 s, CoM within 5 mm at every logged instant, final CoM within 2 mm, seated "

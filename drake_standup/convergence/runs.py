@@ -29,6 +29,7 @@ def run_case(
     duration_s: float,
     out_dir: str,
     inputs: dict,
+    overrides: list | tuple = (),
 ) -> dict:
     """Simulates one run into out_dir (in a Dask worker); returns its metrics.
 
@@ -46,7 +47,7 @@ def run_case(
     for name in RUN_FILES:
         (run_dir / name).unlink(missing_ok=True)
     try:
-        scenario = parse_scenario(scenario_text, where)
+        scenario = parse_scenario(scenario_text, where, overrides)
         scenario.plant.time_step = step_s
         scenario.controller_period_s = controller_period_s
         scenario.duration_s = duration_s

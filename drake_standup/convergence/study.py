@@ -48,8 +48,10 @@ def run_study(
     address: str | None = None,
     fresh: bool = False,
     progress: bool = True,
+    overrides: list | tuple = (),
 ) -> StudyResult:
-    """Simulates what OUT/runs/ does not hold yet, compares, chooses, reports."""
+    """Simulates what OUT/runs/ does not hold yet, compares, chooses, reports;
+    overrides: (key path, value) pairs set in every run's scenario (--set)."""
     from drake_standup.cluster import run_on_cluster
     from drake_standup.records import write_json
 
@@ -59,7 +61,7 @@ def run_study(
     texts = {s: (SCENARIO_DIR / f"{s}.yaml").read_text() for s in scenarios}
     durations = {s: scenario_duration_s(s, texts[s]) for s in scenarios}
     cases = study_cases(scenarios, steps_ms)
-    inputs = {c: case_inputs(c, texts[c.scenario], durations[c.scenario]) for c in cases}
+    inputs = {c: case_inputs(c, texts[c.scenario], durations[c.scenario], overrides) for c in cases}
     todo = [c for c in cases if fresh or not is_cached(runs_dir / c.name, inputs[c])]
     # Longest first, so that two workers finish together.
     todo.sort(key=lambda c: -durations[c.scenario] / (c.step_s * (1 + c.factor)))
@@ -90,6 +92,7 @@ def run_study(
                     durations[c.scenario],
                     str((runs_dir / c.name).resolve()),
                     inputs[c],
+                    list(overrides),
                 ),
             )
             for c in todo
@@ -124,6 +127,7 @@ def run_study(
         },
         "scenarios": {s: {"duration_s": durations[s]} for s in scenarios},
         "steps_ms": sorted(steps_ms),
+        "overrides": [[path, value] for path, value in overrides],
         "configurations": config_table(records),
         "choice": choice,
         "study_wall_s": wall_s,
@@ -133,7 +137,7 @@ def run_study(
     }
     files = [out_dir / "convergence.json", out_dir / "convergence.md", out_dir / "convergence.png"]
     write_json(files[0], _inf_as_text(study))
-    files[1].write_text(markdown(records, choice, wall_s if todo else None))
+    files[1].write_text(markdown(records, choice, wall_s if todo else None, overrides))
     draw_figure(records, files[2])
     return StudyResult(records, choice, len(todo), len(cases) - len(todo), wall_s, files)
 
