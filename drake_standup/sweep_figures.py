@@ -58,7 +58,7 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
         ax.text(
             0.01,
             0.01,
-            "lines: mean over runs that stood up; x: a run that failed, at its value or, "
+            "lines: mean over runs that stood up; x: a run that failed, at its value or,\n"
             "without one, on the x axis (reason in results.csv)",
             transform=ax.transAxes,
             fontsize=7,
