@@ -659,3 +659,49 @@ def test_scaled_model_terms_are_drakes_with_scaled_masses(scene, scale):
         np.testing.assert_allclose(
             terms.p_WCom, plant.CalcCenterOfMassPositionInWorld(context, [instance]), atol=1e-12
         )
+
+
+def _at_a_limit(scene, seed):
+    """A random seated state with three joints pressed against a limit (at it, moving
+    into it): their soft rows are in play, the others' are not."""
+    scene_, x0 = scene
+    plant, instance = scene_.plant, scene_.robot.model_instance
+    x = _random_state(plant, instance, x0, np.random.default_rng(seed)).copy()
+    context = plant.CreateDefaultContext()
+    plant.SetPositionsAndVelocities(context, instance, x)
+    for name, side in (("l_knee", 1), ("torso_pitch", -1), ("r_elbow", 1)):
+        joint = plant.GetJointByName(name, instance)
+        limit = (joint.position_upper_limits() if side > 0 else joint.position_lower_limits())[0]
+        joint.set_angle(context, float(limit) - side * 1e-3)
+        joint.set_angular_rate(context, side * 0.5)
+    return plant.GetPositionsAndVelocities(context, instance)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.parametrize("standup_state", [2, 4])
+def test_screened_soft_rows_give_the_full_programs_solution(scene, seed, standup_state):
+    """The QP solved without the soft rows of joints whose limit is not in play (and
+    again with any that break in) has the full program's optimum: the same torques,
+    accelerations and wrenches, tick after tick, whatever was kept from the tick before."""
+    x = _at_a_limit(scene, seed)
+    plant, instance = scene[0].plant, scene[0].robot.model_instance
+    com = _com(plant, instance, x)
+    rigs = {screen: _Rig(scene[0]) for screen in (True, False)}
+    solutions = {}
+    for screen, rig in rigs.items():
+        rig.fix(x, np.concatenate([com, np.zeros(6)]), standup_state)
+        first = rig.tick()
+        qp = rig.controller.program(rig.controller._last[0].active).qp
+        qp._screen = screen
+        solutions[screen] = [rig.tick() for _ in range(3)]  # kept set from the tick before
+        assert first.ok
+    qp = rigs[True].controller.program(rigs[True].controller._last[0].active).qp
+    assert 0 < qp._soft_kept.sum() < len(qp._soft_kept)  # some rows in play, most left out
+    assert qp.screening_resolves >= 1  # the first tick kept none: the pressed joints broke in
+    for screened, full in zip(solutions[True], solutions[False], strict=True):
+        assert screened.ok and full.ok
+        assert np.abs(full.slack).max() > 1e-6  # the limits are in play
+        np.testing.assert_allclose(screened.tau, full.tau, atol=1e-6)
+        np.testing.assert_allclose(screened.vdot, full.vdot, atol=1e-6)
+        np.testing.assert_allclose(screened.F_C, full.F_C, atol=1e-6)
+        np.testing.assert_allclose(screened.slack, full.slack, atol=1e-7)

@@ -33,8 +33,13 @@ class DaqpBackend:
         self._sense = np.zeros(size, dtype=np.int32)
 
     def solve(self, H, g, A, lo, hi, equality) -> tuple[np.ndarray, bool]:
-        np.multiply(equality, self.EQUALITY, out=self._sense)
-        z, _, exitflag, _ = daqp.solve(H, g, A, hi, lo, self._sense)
+        """Any size of program (the QP leaves rows out: control/qp.py)."""
+        if len(equality) == len(self._sense):
+            sense = self._sense
+            np.multiply(equality, self.EQUALITY, out=sense)
+        else:
+            sense = (equality * self.EQUALITY).astype(np.int32)
+        z, _, exitflag, _ = daqp.solve(H, g, A, hi, lo, sense)
         return np.asarray(z), exitflag >= 1
 
 
