@@ -17,7 +17,7 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Ve
 
 from drake_standup.config import Scenario, validate
 from drake_standup.control.controller import WholeBodyController
-from drake_standup.human import HumanWrenchSource
+from drake_standup.human import HelperWork, HumanWrenchSource
 from drake_standup.robot import actuated_joints
 from drake_standup.scene import Scene, set_seated_state
 from drake_standup.standup_controller import make_standup_controller
@@ -33,6 +33,7 @@ STATION_SIGNALS = (
     "com_W",
     "net_actuation",
     "standing_pull_usage",
+    "hand_velocities_W",
 )
 CONTROLLER_SIGNALS = (
     "psi",
@@ -102,8 +103,15 @@ def build_diagram(
     builder.Connect(
         human.GetOutputPort("hand_wrenches_W"), world.GetInputPort("applied_hand_wrenches_W")
     )
+    # What the helper spends, on the plant's own steps (human.HelperWork).
+    spent = builder.AddNamedSystem(
+        "helper_work", HelperWork(station.plant, station.robot, scenario.plant.time_step)
+    )
+    builder.Connect(world.GetOutputPort("robot_state"), spent.GetInputPort("robot_state"))
+    builder.Connect(human.GetOutputPort("hand_wrenches_W"), spent.GetInputPort("hand_wrenches_W"))
     outputs = {name: world.GetOutputPort(name) for name in STATION_SIGNALS}
     outputs["applied_hand_wrenches_W"] = human.GetOutputPort("hand_wrenches_W")
+    outputs["helper_spent"] = spent.GetOutputPort("helper_spent")
     if station.diagram.HasOutputPort("push_force_W"):
         outputs["push_force_W"] = world.GetOutputPort("push_force_W")
     standup = None

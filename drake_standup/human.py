@@ -28,6 +28,13 @@ from drake_standup.robot import Robot
 
 HANDS = {"left": 0, "right": 1}
 TASK_FRAMES = ("l_hand", "r_hand")
+# HelperWork's output, entry by entry (signals.npz and metrics.json name them so).
+HELPER_SPENT = (
+    "helper_work_J",
+    "helper_positive_work_J",
+    "helper_impulse_Ns",
+    "helper_peak_force_N",
+)
 
 
 def hand_forces(plant: MultibodyPlant, robot: Robot) -> list[ExternallyAppliedSpatialForce]:
@@ -319,3 +326,58 @@ class HumanWrenchSource(LeafSystem):
 
     def _CalcSpatialForces(self, context: Context, output) -> None:
         output.set_value(spatial_forces(self._applied, self._wrenches_cache.Eval(context)))
+
+
+class HelperWork(LeafSystem):
+    """What the helper spends on the robot, as the discrete plant integrates it.
+
+    Inputs robot_state [q; v] and hand_wrenches_W (12: the pull applied, [0, f_l, 0,
+    f_r]). Updated at every plant step t_n (period step_s): the plant holds the pull of
+    t_n over its step, so the step's work is f_n . (p_{n+1} - p_n) per hand, with p the
+    hand frame's origin where the pull acts (hand_forces), from the state's forward
+    kinematics. Output helper_spent (4): [work J, its positive part J (per step,
+    max(work, 0)), impulse N s (sum of |f_l| + |f_r| times the step), peak |f| of
+    either hand N], over the steps taken so far."""
+
+    def __init__(self, plant: MultibodyPlant, robot: Robot, step_s: float):
+        super().__init__()
+        self._plant = plant
+        self._instance = robot.model_instance
+        self._context = plant.CreateDefaultContext()
+        self._hands = [robot.frame(plant, name) for name in TASK_FRAMES]
+        self._step_s = step_s
+        nx = plant.num_multibody_states(self._instance)
+        self._state_input = self.DeclareVectorInputPort("robot_state", nx)
+        self._wrenches = self.DeclareVectorInputPort("hand_wrenches_W", 12)
+        # [totals (4), p_l, p_r at the last step (6), f_l, f_r held since (6), started].
+        self._memory = self.DeclareDiscreteState(17)
+        self.DeclareVectorOutputPort(
+            "helper_spent",
+            4,
+            self._CalcSpent,
+            prerequisites_of_calc={self.discrete_state_ticket(self._memory)},
+        )
+        self.DeclarePeriodicDiscreteUpdateEvent(step_s, 0.0, self._Update)
+
+    def _CalcSpent(self, context: Context, output: BasicVector) -> None:
+        output.SetFromVector(context.get_discrete_state(self._memory).value()[:4])
+
+    def _positions(self, context: Context) -> np.ndarray:
+        self._plant.SetPositionsAndVelocities(
+            self._context, self._instance, self._state_input.Eval(context)
+        )
+        return np.concatenate([f.CalcPoseInWorld(self._context).translation() for f in self._hands])
+
+    def _Update(self, context: Context, discrete_state) -> None:
+        memory = context.get_discrete_state(self._memory).value().copy()
+        p = self._positions(context)
+        if memory[16]:  # the step just taken, under the pull held since the last one
+            work = float(memory[10:16] @ (p - memory[4:10]))
+            memory[0] += work
+            memory[1] += max(work, 0.0)
+            held = np.linalg.norm(memory[10:16].reshape(2, 3), axis=1)
+            memory[2] += held.sum() * self._step_s
+            memory[3] = max(memory[3], held.max())
+        F = self._wrenches.Eval(context)
+        memory[4:10], memory[10:16], memory[16] = p, np.r_[F[3:6], F[9:12]], 1.0
+        discrete_state.set_value(self._memory, memory)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from drake_standup.human import HELPER_SPENT
 from drake_standup.scene import erect_com_height_m
 from drake_standup.signals import group_normal_forces
 
@@ -110,6 +111,64 @@ def standup_metrics(
     return metrics
 
 
+def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
+    """int y dt by the trapezoid rule (numpy < 2 has no np.trapezoid)."""
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
+
+
+def helper_metrics(
+    time_s: np.ndarray, hand_wrenches_W: np.ndarray, hand_velocities_W: np.ndarray
+) -> dict:
+    """What the helper spent, from the hands' measured forces (hand_wrenches_W: N x 12,
+    [tau_l, f_l, tau_r, f_r]) and the velocities of the points they pull
+    (hand_velocities_W: N x 6, [v_l, v_r]), by the trapezoid rule on the samples:
+    helper_work_J = int F . v dt over both hands; helper_positive_work_J its positive
+    part, int max(F . v, 0) dt; helper_peak_force_N the larger hand's peak |f|;
+    helper_impulse_Ns = int (|f_l| + |f_r|) dt."""
+    f = np.stack([hand_wrenches_W[:, 3:6], hand_wrenches_W[:, 9:12]], axis=1)  # N x 2 x 3
+    v = hand_velocities_W.reshape(len(time_s), 2, 3)
+    power_W = np.einsum("nhk,nhk->n", f, v)
+    magnitude_N = np.linalg.norm(f, axis=2)  # N x 2
+    if len(time_s) < 2:
+        zero = 0.0
+        peak = float(magnitude_N.max()) if magnitude_N.size else 0.0
+        return {
+            "helper_work_J": zero,
+            "helper_positive_work_J": zero,
+            "helper_peak_force_N": peak,
+            "helper_impulse_Ns": zero,
+        }
+    return {
+        "helper_work_J": _trapezoid(power_W, time_s),
+        "helper_positive_work_J": _trapezoid(np.maximum(power_W, 0.0), time_s),
+        "helper_peak_force_N": float(magnitude_N.max()),
+        "helper_impulse_Ns": _trapezoid(magnitude_N.sum(axis=1), time_s),
+    }
+
+
+def path_deviation_max_m(points_W: np.ndarray, path_W: np.ndarray) -> float | None:
+    """The largest distance from a point (N x 3: the CoM) to a path given by its samples
+    in order (M x 3: the CoM reference x_d(psi) as psi ran), the polyline through them:
+    how far the CoM strays from the path, not from where the reference is at time t."""
+    if not len(points_W) or not len(path_W):
+        return None
+    a = path_W[:-1]
+    ab = path_W[1:] - a
+    keep = np.einsum("mk,mk->m", ab, ab) > 0.0  # repeated samples (psi held) are no segment
+    a, ab = a[keep], ab[keep]
+    if not len(a):  # the reference never moved: the distance to its one point
+        return float(np.linalg.norm(points_W - path_W[0], axis=1).max())
+    worst = 0.0
+    length2 = np.einsum("mk,mk->m", ab, ab)
+    for chunk in np.array_split(points_W, max(1, len(points_W) // 256)):
+        ap = chunk[:, None, :] - a[None, :, :]  # n x m x 3
+        u = np.clip(np.einsum("nmk,mk->nm", ap, ab) / length2, 0.0, 1.0)
+        nearest = a[None] + u[..., None] * ab[None]
+        d = np.linalg.norm(chunk[:, None, :] - nearest, axis=2).min(axis=1)
+        worst = max(worst, float(d.max()))
+    return worst
+
+
 def run_metrics(
     signals: dict[str, np.ndarray],
     station,
@@ -153,6 +212,18 @@ def run_metrics(
         metrics["held_back_s"] = float(signals["held_back_s"][-1])
         if "held_back_beyond_feet_s" in signals:  # signals.npz before issue 21 lack it
             metrics["held_back_beyond_feet_s"] = float(signals["held_back_beyond_feet_s"][-1])
+    if samples and "helper_work_J" in signals:  # the plant's steps' totals (HelperWork)
+        metrics.update({name: float(signals[name][-1]) for name in HELPER_SPENT})
+    elif "hand_velocities_W" in signals:  # the logged samples only
+        metrics.update(
+            helper_metrics(
+                signals["time_s"], signals["hand_wrenches_W"], signals["hand_velocities_W"]
+            )
+        )
+    if "com_reference_W" in signals:
+        metrics["path_deviation_max_m"] = path_deviation_max_m(
+            signals["com_W"], signals["com_reference_W"]
+        )
     torques = signals["joint_torques_Nm"]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
     return metrics

@@ -14,6 +14,7 @@ import numpy as np
 
 from drake_standup.control.controller import DIAGNOSTICS
 from drake_standup.control.schedule import CONTACTS
+from drake_standup.human import HELPER_SPENT
 from drake_standup.payloads import COM_REFERENCE, SEGMENT
 
 # Version of signals.npz's layout; bump it (and keep load_signals reading the
@@ -89,6 +90,11 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
         signals["push_force_W"] = logs["push_force_W"]
     if "standing_pull_usage" in logs:  # sensing.standing_pull_usage of the measured pull
         signals["standing_pull_usage"] = logs["standing_pull_usage"][:, 0]
+    if "hand_velocities_W" in logs:  # [v_left, v_right] where the hands are pulled
+        signals["hand_velocities_W"] = logs["hand_velocities_W"]
+    if "helper_spent" in logs:  # human.HelperWork's running totals, on the plant's steps
+        for k, name in enumerate(HELPER_SPENT):
+            signals[name] = logs["helper_spent"][:, k]
     if "controller_diagnostics" not in logs:  # the seat-hold benchmark: no controller
         return signals
     reference = COM_REFERENCE.unpack(logs["com_reference"])

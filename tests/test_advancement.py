@@ -246,3 +246,34 @@ def test_omega_f_matches_the_papers_formula():
             plant.CalcCenterOfMassTranslationalVelocityInWorld(plant_context),
             atol=1e-12,
         )
+
+
+def test_hand_velocities_are_the_hand_origins_displacement_rate():
+    """RobotSensing's hand_velocities_W against forward kinematics alone: the hand
+    frames' origins at q and at q + eps qdot (qdot = N(q) v, the quaternion
+    renormalised), over eps, at random states."""
+    plant = MultibodyPlant(0.0)
+    robot = add_icub(plant, visuals=False, contact=ContactModel())
+    plant.Finalize()
+    sensing = RobotSensing(plant, robot, {})
+    context = sensing.CreateDefaultContext()
+    plant_context = plant.CreateDefaultContext()
+    hands = [robot.frame(plant, name) for name in ("l_hand", "r_hand")]
+    rng = np.random.default_rng(7)
+    nq, eps = plant.num_positions(), 1e-7
+
+    def origins(q):
+        plant.SetPositions(plant_context, q)
+        return np.concatenate([h.CalcPoseInWorld(plant_context).translation() for h in hands])
+
+    for _ in range(5):
+        q = np.concatenate([rng.normal(size=4), rng.normal(size=3), rng.uniform(-1, 1, nq - 7)])
+        q[:4] /= np.linalg.norm(q[:4])
+        v = rng.normal(size=plant.num_velocities())
+        sensing.GetInputPort("robot_state").FixValue(context, np.concatenate([q, v]))
+        measured = sensing.GetOutputPort("hand_velocities_W").Eval(context)
+        plant.SetPositions(plant_context, q)
+        q_next = q + eps * plant.MapVelocityToQDot(plant_context, v)
+        q_next[:4] /= np.linalg.norm(q_next[:4])
+        expected = (origins(q_next) - origins(q)) / eps
+        np.testing.assert_allclose(measured, expected, rtol=1e-4, atol=1e-5)

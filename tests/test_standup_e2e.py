@@ -243,3 +243,58 @@ def test_seat_pads_unload_once_and_stay_unloaded(run, group, request):
     switches = np.flatnonzero(loaded[:-1] != loaded[1:])
     assert len(switches) == 1 and loaded[switches[0]], (group, t[t > 1.0][switches])
     assert force[switches[0] + 1 :].max() <= 5.0
+
+
+def _hand_positions(scenario, sig) -> np.ndarray:
+    """The hand frames' origins (N x 2 x 3) by forward kinematics of the logged poses."""
+    from pydrake.common.eigen_geometry import Quaternion
+    from pydrake.math import RigidTransform
+
+    from drake_standup.station import make_station
+
+    station = make_station(scenario)
+    plant, robot = station.plant, station.robot
+    context = plant.CreateDefaultContext()
+    base = plant.GetBodyByName("root_link", robot.model_instance)
+    joints = [plant.GetJointByName(str(n), robot.model_instance) for n in sig["joint_names"]]
+    hands = [robot.frame(plant, name) for name in ("l_hand", "r_hand")]
+    out = np.empty((len(sig["time_s"]), 2, 3))
+    for i in range(len(sig["time_s"])):
+        q = sig["base_quaternion_wxyz"][i]
+        pose = RigidTransform(Quaternion(q / np.linalg.norm(q)), sig["base_position_W"][i])
+        plant.SetFreeBodyPose(context, base, pose)
+        for joint, angle in zip(joints, sig["joint_positions_rad"][i], strict=True):
+            joint.set_angle(context, float(angle))
+        out[i] = [hand.CalcPoseInWorld(context).translation() for hand in hands]
+    return out
+
+
+def test_the_helpers_work_is_force_times_the_hands_displacement(assisted_run):
+    """Over the pull's plateau (15 + 15 N per hand, constant from 3.5 to 10.5 s) the
+    helper's work, summed on the plant's steps, is F . (p(t2) - p(t1)) for each hand,
+    p from forward kinematics of the logged poses. The same work from the logged
+    velocities (the trapezoid rule on 10 ms samples of a 4 ms plant) is within 5 %
+    (test_advancement checks the velocities themselves)."""
+    from drake_standup.metrics import helper_metrics
+
+    scenario, m, sig = assisted_run
+    t = sig["time_s"]
+    assert m["helper_peak_force_N"] == pytest.approx(np.hypot(15.0, 15.0), rel=1e-9)
+    # Both hands, the trapezoid's 8 s of which 7 at full force and two 0.5 s ramps.
+    assert m["helper_impulse_Ns"] == pytest.approx(2 * np.hypot(15.0, 15.0) * 7.5, rel=2e-3)
+    p = _hand_positions(scenario, sig)
+    plateau = (t >= 3.5) & (t <= 10.5)
+    i1, i2 = np.flatnonzero(plateau)[[0, -1]]
+    F = np.array([15.0, 0.0, 15.0])
+    by_displacement = float(F @ (p[i2] - p[i1]).sum(axis=0))
+    assert by_displacement > 5.0  # the hands travelled forward and up with the robot
+    work = sig["helper_work_J"]
+    assert work[i2] - work[i1] == pytest.approx(by_displacement, rel=1e-5)  # 2e-6 seen
+    assert m["helper_work_J"] == pytest.approx(work[-1])
+    assert m["helper_positive_work_J"] >= m["helper_work_J"]
+    window = slice(i1, i2 + 1)
+    by_samples = helper_metrics(
+        t[window], sig["hand_wrenches_W"][window], sig["hand_velocities_W"][window]
+    )["helper_work_J"]
+    assert by_samples == pytest.approx(by_displacement, rel=0.05)
+    assert 0.0 < m["path_deviation_max_m"] < 0.1

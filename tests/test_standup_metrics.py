@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drake_standup.metrics import standup_metrics
+from drake_standup.metrics import helper_metrics, path_deviation_max_m, standup_metrics
 
 PADS = {
     "l_sole_pad": "soles",
@@ -150,3 +150,67 @@ def test_leaning_against_a_pull_lowers_the_standing_height():
     assert abs(0.5625 - tilted) < 0.01 < abs(0.5625 - 0.575)
     m = standup_metrics(sig, ENTRIES, standing_height_m=0.575)
     assert m["standup_time_s"] == pytest.approx(5.0, abs=DT)
+
+
+# --- What the helper spends, and the path deviation, against closed forms --------------
+
+
+def _hands(t, f_left, f_right, v_left, v_right):
+    """hand_wrenches_W (N x 12) and hand_velocities_W (N x 6) from per-sample arrays."""
+    n = len(t)
+    wrenches = np.zeros((n, 12))
+    wrenches[:, 3:6], wrenches[:, 9:12] = f_left, f_right
+    return wrenches, np.hstack([v_left, v_right])
+
+
+def test_helper_work_impulse_and_peak_of_constant_forces_on_moving_hands():
+    """F_l = (10, 0, 5) N on a hand accelerating along x at a = 0.3 m/s^2 from rest, so
+    its power 3 t W is linear and the trapezoid rule exact: 0.15 T^2 J; F_r = (-2, 0, 0)
+    N on a hand moving at 0.1 m/s along x: -0.2 T J. Impulse (|F_l| + |F_r|) T."""
+    T, a = 2.0, 0.3
+    t = np.linspace(0.0, T, 201)
+    zeros = np.zeros((len(t), 3))
+    v_left = zeros.copy()
+    v_left[:, 0] = a * t
+    v_right = zeros.copy()
+    v_right[:, 0] = 0.1
+    wrenches, velocities = _hands(t, [10.0, 0.0, 5.0], [-2.0, 0.0, 0.0], v_left, v_right)
+    m = helper_metrics(t, wrenches, velocities)
+    assert m["helper_work_J"] == pytest.approx(10.0 * a * T**2 / 2 - 0.2 * T, rel=1e-12)
+    assert m["helper_peak_force_N"] == pytest.approx(np.hypot(10.0, 5.0))
+    assert m["helper_impulse_Ns"] == pytest.approx((np.hypot(10.0, 5.0) + 2.0) * T, rel=1e-12)
+
+
+def test_positive_work_is_the_part_where_the_helper_puts_power_in():
+    """Power 3 (t - 1) W over [0, 2] s: no net work, 1.5 J put in after t = 1 s."""
+    t = np.linspace(0.0, 2.0, 201)  # a sample at t = 1
+    v = np.zeros((len(t), 3))
+    v[:, 0] = t - 1.0
+    wrenches, velocities = _hands(t, [3.0, 0.0, 0.0], [0.0, 0.0, 0.0], v, np.zeros_like(v))
+    m = helper_metrics(t, wrenches, velocities)
+    assert m["helper_work_J"] == pytest.approx(0.0, abs=1e-12)
+    assert m["helper_positive_work_J"] == pytest.approx(1.5, rel=1e-12)
+
+
+def test_path_deviation_is_the_distance_to_the_curve_not_to_the_point_at_time_t():
+    """A reference along a quarter circle of radius 0.3 m, the CoM 1 cm outside it
+    (radially) and lagging it by a tenth of the arc: 1 cm from the path (to the polyline
+    through 2001 samples: within R (1 - cos(dtheta / 2)) = 5.8e-8 m), while it is 4.7 cm
+    from where the reference is at the same instant."""
+    R, d = 0.3, 0.01
+    theta = np.linspace(0.0, np.pi / 2, 2001)
+    path = np.stack([R * np.cos(theta), np.zeros_like(theta), R * np.sin(theta)], axis=1)
+    lag = np.clip(theta - 0.1 * np.pi / 2, 0.0, None)
+    com = np.stack([(R + d) * np.cos(lag), np.zeros_like(lag), (R + d) * np.sin(lag)], axis=1)
+    assert path_deviation_max_m(com, path) == pytest.approx(d, abs=1e-7)
+    assert np.linalg.norm(com - path, axis=1).max() > 4 * d
+
+
+def test_path_deviation_of_a_straight_path_held_still_in_places():
+    """Repeated samples (psi held, a segment of zero length) are no segment: the distance
+    to a straight path is the perpendicular one, or to its end beyond it."""
+    path = np.array([[0.0, 0, 0], [0.0, 0, 0], [0.1, 0, 0], [0.2, 0, 0], [0.2, 0, 0]])
+    com = np.array([[0.05, 0.02, 0.0], [0.25, 0.0, 0.0]])
+    assert path_deviation_max_m(com, path) == pytest.approx(0.05)
+    assert path_deviation_max_m(com[:1], path) == pytest.approx(0.02)
+    assert path_deviation_max_m(com, path[:1]) == pytest.approx(0.25)  # a reference held
