@@ -199,19 +199,24 @@ def test_lead_gate_waits_while_the_com_lags():
     assert psi_dot_law(CFG, v, omega_f, TANGENT, 0.001)[0] > 1.7
 
 
+def _sensing_rig():
+    """(plant, RobotSensing, its context, a plant context, the hand frames): the iCub
+    without pads, finalized, its sensing with no heels."""
+    plant = MultibodyPlant(0.0)
+    robot = add_icub(plant, visuals=False, contact=ContactModel())
+    plant.Finalize()
+    sensing = RobotSensing(plant, robot, {})
+    hands = [robot.frame(plant, name) for name in ("l_hand", "r_hand")]
+    return plant, sensing, sensing.CreateDefaultContext(), plant.CreateDefaultContext(), hands
+
+
 def test_omega_f_matches_the_papers_formula():
     """RobotSensing returns sum F / m (linear momentum theorem); the paper's
     Omega f = J_com M^-1 sum J_h^T F_h, computed here with Drake's mass matrix,
     CoM Jacobian and hand Jacobians, must agree at any configuration, wherever
     the force acts (hand torques do not move the CoM)."""
-    plant = MultibodyPlant(0.0)
-    robot = add_icub(plant, visuals=False, contact=ContactModel())
-    plant.Finalize()
-    sensing = RobotSensing(plant, robot, {})
-    context = sensing.CreateDefaultContext()
-    plant_context = plant.CreateDefaultContext()
+    plant, sensing, context, plant_context, hands = _sensing_rig()
     world = plant.world_frame()
-    hands = [robot.frame(plant, name) for name in ("l_hand", "r_hand")]
     rng = np.random.default_rng(3)
     nq = plant.num_positions()
     for _ in range(5):
@@ -252,13 +257,7 @@ def test_hand_velocities_are_the_hand_origins_displacement_rate():
     """RobotSensing's hand_velocities_W against forward kinematics alone: the hand
     frames' origins at q and at q + eps qdot (qdot = N(q) v, the quaternion
     renormalised), over eps, at random states."""
-    plant = MultibodyPlant(0.0)
-    robot = add_icub(plant, visuals=False, contact=ContactModel())
-    plant.Finalize()
-    sensing = RobotSensing(plant, robot, {})
-    context = sensing.CreateDefaultContext()
-    plant_context = plant.CreateDefaultContext()
-    hands = [robot.frame(plant, name) for name in ("l_hand", "r_hand")]
+    plant, sensing, context, plant_context, hands = _sensing_rig()
     rng = np.random.default_rng(7)
     nq, eps = plant.num_positions(), 1e-7
 
