@@ -405,3 +405,34 @@ def test_pacing_reports_the_achieved_rate_once_a_second_and_never_catches_up(mon
         sim.t += 1 / 16
         session._pace(sim)
     assert lines == [] and len(sim.restarts) == 8
+
+
+def test_live_bench_refuses_a_bad_scenario_with_one_line(capsys):
+    from drake_standup.live_bench import main
+
+    assert main(["--scenario", "nosuch"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: ") and "nosuch" in err[0]
+
+
+def test_live_bench_helper_sets_both_hands_sliders_between_chunks():
+    """The scripted helper of the live benchmark pulls through the page's sliders (the
+    switch on, the left hand's pair), once its wall-time delay has passed: the plant then
+    applies the pull at both hands."""
+    from drake_standup.live_bench import ScriptedHelper
+
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
+    meshcat = make_live_meshcat()
+    session = ScriptedHelper(scenario, meshcat, (12.0, 6.0), 0.0, report=lambda line: None)
+    run = prepare(scenario, meshcat, make_human=session.make_human, live_transforms=True)
+    session.started(run)
+    advance(run, 0.1)
+    assert not session.after_chunk(run)
+    assert session.pulled_at_s == pytest.approx(0.1)
+    assert meshcat.GetSliderValue(SLIDERS["left", "fwd"]) == 12.0
+    advance(run, 0.1 + 2 * scenario.plant.time_step)
+    forces = session.human.GetOutputPort("hand_wrenches_W").Eval(
+        session.human.GetMyContextFromRoot(run.simulator.get_context())
+    )
+    np.testing.assert_array_equal(forces[3:6], [12.0, 0.0, 6.0])
+    np.testing.assert_array_equal(forces[9:12], [12.0, 0.0, 6.0])
