@@ -142,8 +142,8 @@ def test_plant_step_model_build_memory_and_machine(tiny):
     for stats in (bare, whole):
         assert stats["steps"] == PLANT_STEPS
         assert 0.0 < stats["median"] <= stats["p95"]
-    # The seat-hold diagram is the bare plant plus the Python systems and loggers.
-    assert whole["median"] > bare["median"]
+    # Not compared with each other: the Python systems the seat-hold diagram adds now
+    # cost less than the shared machine's noise (775 against 780 us, reversed, in CI).
 
     build = summary["model_build"]
     assert build["meshes_converted_cold"] > 0  # the cold cache really converted meshes
