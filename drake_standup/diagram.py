@@ -104,10 +104,8 @@ def build_diagram(
         human.GetOutputPort("hand_wrenches_W"), world.GetInputPort("applied_hand_wrenches_W")
     )
     # What the helper spends, on the plant's own steps (human.HelperWork).
-    spent = builder.AddNamedSystem(
-        "helper_work", HelperWork(station.plant, station.robot, scenario.plant.time_step)
-    )
-    builder.Connect(world.GetOutputPort("robot_state"), spent.GetInputPort("robot_state"))
+    spent = builder.AddNamedSystem("helper_work", HelperWork(scenario.plant.time_step))
+    builder.Connect(world.GetOutputPort("hand_positions_W"), spent.GetInputPort("hand_positions_W"))
     builder.Connect(human.GetOutputPort("hand_wrenches_W"), spent.GetInputPort("hand_wrenches_W"))
     outputs = {name: world.GetOutputPort(name) for name in STATION_SIGNALS}
     outputs["applied_hand_wrenches_W"] = human.GetOutputPort("hand_wrenches_W")

@@ -331,23 +331,18 @@ class HumanWrenchSource(LeafSystem):
 class HelperWork(LeafSystem):
     """What the helper spends on the robot, as the discrete plant integrates it.
 
-    Inputs robot_state [q; v] and hand_wrenches_W (12: the pull applied, [0, f_l, 0,
-    f_r]). Updated at every plant step t_n (period step_s): the plant holds the pull of
-    t_n over its step, so the step's work is f_n . (p_{n+1} - p_n) per hand, with p the
-    hand frame's origin where the pull acts (hand_forces), from the state's forward
-    kinematics. Output helper_spent (4): [work J, its positive part J (per step,
-    max(work, 0)), impulse N s (sum of |f_l| + |f_r| times the step), peak |f| of
-    either hand N], over the steps taken so far."""
+    Inputs hand_positions_W (6: the left and right hand frame's origin, where the pull
+    acts, hand_forces; sensing.py) and hand_wrenches_W (12: the pull applied, [0, f_l,
+    0, f_r]). Updated at every plant step t_n (period step_s): the plant holds the pull
+    of t_n over its step, so the step's work is f_n . (p_{n+1} - p_n) per hand. Output
+    helper_spent (4): [work J, its positive part J (per step, max(work, 0)), impulse
+    N s (sum of |f_l| + |f_r| times the step), peak |f| of either hand N], over the
+    steps taken so far."""
 
-    def __init__(self, plant: MultibodyPlant, robot: Robot, step_s: float):
+    def __init__(self, step_s: float):
         super().__init__()
-        self._plant = plant
-        self._instance = robot.model_instance
-        self._context = plant.CreateDefaultContext()
-        self._hands = [robot.frame(plant, name) for name in TASK_FRAMES]
         self._step_s = step_s
-        nx = plant.num_multibody_states(self._instance)
-        self._state_input = self.DeclareVectorInputPort("robot_state", nx)
+        self._positions = self.DeclareVectorInputPort("hand_positions_W", 6)
         self._wrenches = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         # [totals (4), p_l, p_r at the last step (6), f_l, f_r held since (6), started].
         self._memory = self.DeclareDiscreteState(17)
@@ -362,15 +357,9 @@ class HelperWork(LeafSystem):
     def _CalcSpent(self, context: Context, output: BasicVector) -> None:
         output.SetFromVector(context.get_discrete_state(self._memory).value()[:4])
 
-    def _positions(self, context: Context) -> np.ndarray:
-        self._plant.SetPositionsAndVelocities(
-            self._context, self._instance, self._state_input.Eval(context)
-        )
-        return np.concatenate([f.CalcPoseInWorld(self._context).translation() for f in self._hands])
-
     def _Update(self, context: Context, discrete_state) -> None:
         memory = context.get_discrete_state(self._memory).value().copy()
-        p = self._positions(context)
+        p = self._positions.Eval(context)
         if memory[16]:  # the step just taken, under the pull held since the last one
             work = float(memory[10:16] @ (p - memory[4:10]))
             memory[0] += work

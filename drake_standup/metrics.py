@@ -129,19 +129,10 @@ def helper_metrics(
     v = hand_velocities_W.reshape(len(time_s), 2, 3)
     power_W = np.einsum("nhk,nhk->n", f, v)
     magnitude_N = np.linalg.norm(f, axis=2)  # N x 2
-    if len(time_s) < 2:
-        zero = 0.0
-        peak = float(magnitude_N.max()) if magnitude_N.size else 0.0
-        return {
-            "helper_work_J": zero,
-            "helper_positive_work_J": zero,
-            "helper_peak_force_N": peak,
-            "helper_impulse_Ns": zero,
-        }
-    return {
+    return {  # the trapezoid rule gives 0 on fewer than two samples
         "helper_work_J": _trapezoid(power_W, time_s),
         "helper_positive_work_J": _trapezoid(np.maximum(power_W, 0.0), time_s),
-        "helper_peak_force_N": float(magnitude_N.max()),
+        "helper_peak_force_N": float(magnitude_N.max()) if magnitude_N.size else 0.0,
         "helper_impulse_Ns": _trapezoid(magnitude_N.sum(axis=1), time_s),
     }
 
@@ -154,12 +145,12 @@ def path_deviation_max_m(points_W: np.ndarray, path_W: np.ndarray) -> float | No
         return None
     a = path_W[:-1]
     ab = path_W[1:] - a
-    keep = np.einsum("mk,mk->m", ab, ab) > 0.0  # repeated samples (psi held) are no segment
-    a, ab = a[keep], ab[keep]
+    length2 = np.einsum("mk,mk->m", ab, ab)
+    keep = length2 > 0.0  # repeated samples (psi held) are no segment
+    a, ab, length2 = a[keep], ab[keep], length2[keep]
     if not len(a):  # the reference never moved: the distance to its one point
         return float(np.linalg.norm(points_W - path_W[0], axis=1).max())
     worst = 0.0
-    length2 = np.einsum("mk,mk->m", ab, ab)
     for chunk in np.array_split(points_W, max(1, len(points_W) // 256)):
         ap = chunk[:, None, :] - a[None, :, :]  # n x m x 3
         u = np.clip(np.einsum("nmk,mk->nm", ap, ab) / length2, 0.0, 1.0)

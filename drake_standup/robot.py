@@ -45,7 +45,7 @@ from pydrake.multibody.tree import (
 )
 
 from drake_standup.config.inputs import CONTACT_FILE, TASK_FRAMES, robot_names
-from drake_standup.config.scenario import EFFORT_LIMIT_NM
+from drake_standup.config.scenario import EFFORT_LIMIT_NM, REFLECTED_INERTIA
 from drake_standup.meshes import cache_dir, converted_obj
 
 DEFAULT_MODEL = "iCubGazeboV2_5"
@@ -71,7 +71,6 @@ MOTOR_INERTIAS: dict[str, float] = {
         for joint in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
     },
 }
-REFLECTED_INERTIA = ("none", "all", "real_robots")
 
 
 def reflects_motor_inertia(setting: str, model_name: str) -> bool:

@@ -16,6 +16,7 @@ from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
 from drake_standup.caching import declare_cached
 from drake_standup.control.references import static_lean
+from drake_standup.human import TASK_FRAMES
 from drake_standup.robot import Robot
 
 
@@ -87,8 +88,9 @@ class RobotSensing(LeafSystem):
     heel_x_W (1, m: the front-most of the two soles' heel edges, so "CoM ahead
     of the heels" holds for both feet) and thigh_x_W (1, m: the mean x of the
     thigh pads' centres, where the seat's support ends; NaN without pads),
-    hand_velocities_W (6, m/s: the left and the right hand frame's origin, where a pull
-    is applied, human.hand_forces; what the helper's work integrates) and, with a
+    hand_positions_W and hand_velocities_W (6 each, m and m/s: the left and the right
+    hand frame's origin, where a pull is applied, human.hand_forces; what the helper's
+    work is summed over, human.HelperWork) and, with a
     StandingSupport, standing_pull_usage (1: standing_pull_usage of the measured pull).
 
     The CoM outputs share one cache entry that depends on robot_state only:
@@ -117,7 +119,7 @@ class RobotSensing(LeafSystem):
             for f, p in (thigh_points or {}).items()
         ]
         self._standing = standing
-        self._hands = [robot.frame(plant, name) for name in ("l_hand", "r_hand")]
+        self._hands = [robot.frame(plant, name) for name in TASK_FRAMES]
         self._g = -plant.gravity_field().gravity_vector()[2]
         nx = plant.num_multibody_states(self._instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
@@ -137,6 +139,9 @@ class RobotSensing(LeafSystem):
         )
         self.DeclareVectorOutputPort(
             "omega_f_W", 3, self._CalcOmegaF, prerequisites_of_calc={self._wrenches.ticket()}
+        )
+        self.DeclareVectorOutputPort(
+            "hand_positions_W", 6, self._CalcHandPositions, prerequisites_of_calc=state_only
         )
         self.DeclareVectorOutputPort(
             "hand_velocities_W", 6, self._CalcHandVelocities, prerequisites_of_calc=state_only
@@ -184,6 +189,12 @@ class RobotSensing(LeafSystem):
     def _CalcThighX(self, context: Context, output: BasicVector) -> None:
         xs = self._points_x(context, self._thighs)
         output.SetAtIndex(0, float(np.mean(xs)) if xs else np.nan)
+
+    def _CalcHandPositions(self, context: Context, output: BasicVector) -> None:
+        self._set_plant_state(context, check=True)
+        output.SetFromVector(
+            np.concatenate([f.CalcPoseInWorld(self._context).translation() for f in self._hands])
+        )
 
     def _CalcHandVelocities(self, context: Context, output: BasicVector) -> None:
         self._set_plant_state(context, check=True)

@@ -18,7 +18,7 @@ Outputs
     pads_vertical_force_N     (1) the vertical force on all the robot's pads
     hand_wrenches_W           (12) the hands' sensors' wrenches (payloads.HAND_WRENCHES)
     com_W, com_velocity_W, omega_f_W, heel_x_W, thigh_x_W   sensing.py
-    hand_velocities_W         (6) the hands' linear velocities where they are pulled, m/s
+    hand_positions_W, hand_velocities_W   (6 each) where the hands are pulled, m, m/s
     standing_pull_usage       (1) the share of the standing feet's hold a pull needs
     push_force_W              (3) only with perturbation.pushes
 """
@@ -146,7 +146,7 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
     builder.Connect(measured, sensing.GetInputPort("hand_wrenches_W"))
     for name in ("com_W", "com_velocity_W", "omega_f_W", "heel_x_W", "thigh_x_W"):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
-    for name in ("standing_pull_usage", "hand_velocities_W"):
+    for name in ("standing_pull_usage", "hand_positions_W", "hand_velocities_W"):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
 
     builder.ExportInput(plant.get_actuation_input_port(instance), "actuation")

@@ -18,7 +18,7 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 from drake_standup.config.controller import QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
-from drake_standup.config.scenario import Scenario
+from drake_standup.config.scenario import REFLECTED_INERTIA, Scenario
 from drake_standup.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
 
 
@@ -64,7 +64,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (("left", "right"), "human.pulls[*].hand"),
     (("velocity", "path"), "human.reactive.guide"),
     (("tangent", "interaction"), "advancement.law"),
-    (("none", "all", "real_robots"), "robot.reflected_inertia"),
+    (REFLECTED_INERTIA, "robot.reflected_inertia"),
     (("hands", "time"), "standup.trigger"),
     (SEAT_HOLDS, "phases.*.seat_hold phases.*.seat_hold_sat_back"),
     (SEAT_PADS, "phases.*.unload[*]"),

@@ -44,6 +44,10 @@ def _seated_joints() -> dict[str, float]:
     return joints
 
 
+# robot.reflected_inertia's settings (robot.reflects_motor_inertia).
+REFLECTED_INERTIA = ("none", "all", "real_robots")
+
+
 @dataclass
 class RobotConfig:
     # Any name from icub_models.get_robot_names().

@@ -378,8 +378,7 @@ class WholeBodyQp:
         if ok:
             # In play: at a bound (within 1e-6 of its width) or moved by its slack.
             s = z[self._slack]
-            moved = self._soft_vdot
-            v = z[moved] - s
+            v = z[self._soft_vdot] - s
             width = 1e-6 * (1.0 + soft_hi - soft_lo)
             self._soft_kept = (np.abs(s) > 1e-9) | (v <= soft_lo + width) | (v >= soft_hi - width)
         return z, ok
