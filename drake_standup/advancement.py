@@ -9,7 +9,8 @@ measured hand wrenches cause, xdot the measured CoM velocity):
                                                      / ((t.Omega f)^2 + eps)
 The interaction helps when alpha = t.Omega f / |t| (the part of Omega f along
 the desired velocity) exceeds alpha_min; otherwise, and with advancement
-disabled, psi_dot = 1 and psi = t. psi therefore never runs backwards nor
+disabled, or with a response other than advancement (config.RESPONSES), psi_dot = 1
+and psi = t. psi therefore never runs backwards nor
 faster than psi_dot_upper.
 
 Lead gate (ours, on by default): the law also waits until the CoM is not behind
@@ -116,7 +117,8 @@ def psi_dot_law(
 
 class TrajectoryAdvancement(LeafSystem):
     """Inputs com_W, com_velocity_W, omega_f_W, x_d_W, path_tangent_W (3 each),
-    path_progress (1) and advances (1: the phase lets psi advance, phases.py).
+    path_progress (1), advances (1: the phase lets psi advance, phases.py) and response
+    (1: the response code; any but advancement's holds psi = t).
 
     Continuous state [psi, psi_dot]: the law sets the rate psi_dot tends to,
     with time constant psi_ddot_filter_s, and psi integrates psi_dot. The
@@ -146,6 +148,7 @@ class TrajectoryAdvancement(LeafSystem):
         # not while balancing seated or returning to the seat after a hindering pull,
         # which a backward pull helps (docs/design.md).
         self._advances = self.DeclareVectorInputPort("advances", 1)
+        self._response = self.DeclareVectorInputPort("response", 1)
         self.DeclareVectorOutputPort(
             "psi",
             1,
@@ -164,6 +167,7 @@ class TrajectoryAdvancement(LeafSystem):
                 self._tangent,
                 self._progress,
                 self._advances,
+                self._response,
             )
         }
         self._law_cache = declare_cached(self, "psi_dot law", self._calc_law, inputs)
@@ -183,6 +187,8 @@ class TrajectoryAdvancement(LeafSystem):
 
     def _calc_law(self, context: Context) -> tuple[float, float]:
         tangent = self._tangent.Eval(context)
+        if self._response.Eval(context)[0] > 0.5:  # stiff or compliant: psi = t
+            return 1.0, helpfulness(tangent, self._omega_f.Eval(context), self._config.eps)
         if self._advances.Eval(context)[0] < 0.5:
             tangent = np.zeros(3)  # a phase that holds psi = t: nothing to advance along
         # The velocity, the lead and the progress only while the interaction helps (a

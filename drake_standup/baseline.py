@@ -31,10 +31,11 @@ from drake_standup.signals import load_signals, write_signals
 
 
 def needs_baseline(scenario: Scenario) -> bool:
-    """Whether psi could advance: advancement on and somebody pulling. Otherwise the run
-    is its own psi = t run."""
+    """Whether psi could advance: the advancement response, advancement on and somebody
+    pulling. Otherwise the run is its own psi = t run."""
     human = scenario.human
-    return scenario.advancement.enabled and (human.mode == "reactive" or bool(human.pulls))
+    pulled = human.mode == "reactive" or bool(human.pulls)
+    return scenario.response == "advancement" and scenario.advancement.enabled and pulled
 
 
 def simulate_quietly(scenario: Scenario, controller: str, chunk_s: float) -> RunResult:

@@ -15,7 +15,7 @@ from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
 from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
 
-from drake_standup.config import Scenario, validate
+from drake_standup.config import RESPONSES, Scenario, validate
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.human import HelperWork, HumanWrenchSource
 from drake_standup.robot import actuated_joints
@@ -47,6 +47,7 @@ CONTROLLER_SIGNALS = (
     "entry_times_s",
     "controller_diagnostics",
     "lean_W",
+    "compliance_W",
     "mass_estimate",
 )
 # Not logged: the visuals' (every publish) and the table's last values only.
@@ -124,12 +125,19 @@ def build_diagram(
     else:
         standup = make_standup_controller(scenario, station)
         brain = builder.AddNamedSystem("standup_controller", standup.diagram)
+        # The robot's response to the pull: the scenario's, or the live helper's switch.
+        if human.HasOutputPort("response"):
+            outputs["response"] = human.GetOutputPort("response")
+        else:
+            response = ConstantVectorSource([float(RESPONSES.index(scenario.response))])
+            outputs["response"] = builder.AddNamedSystem("response", response).get_output_port()
+        builder.Connect(outputs["response"], brain.GetInputPort("response"))
         for i in range(brain.num_input_ports()):
             port = brain.get_input_port(i)
             if port.get_name() == "stand_up":
                 if human.HasOutputPort("stand_up"):
                     builder.Connect(human.GetOutputPort("stand_up"), port)
-            else:
+            elif port.get_name() != "response":
                 builder.Connect(world.GetOutputPort(port.get_name()), port)
         builder.Connect(brain.GetOutputPort("actuation"), world.GetInputPort("actuation"))
         outputs |= {name: brain.GetOutputPort(name) for name in CONTROLLER_SIGNALS}

@@ -194,6 +194,15 @@ def finished(run: Run) -> bool:
     return run.failure_reason is not None or run.time_s >= run.scenario.duration_s - 1e-9
 
 
+def responses_used(signals: dict, default: str) -> str:
+    """The robot's responses to the pull over the run, in the order first used, joined by
+    '+' (one name but where the live page's switch moved; default: no controller)."""
+    if "response" not in signals:
+        return default
+    codes = dict.fromkeys(int(code) for code in signals["response"])
+    return "+".join(str(signals["responses"][code]) for code in codes)
+
+
 def collect(run: Run) -> RunResult:
     """The run's signals and metrics (metrics.py), success and the failure reason: a fall
     or failure, else whether it stood up and stayed standing."""
@@ -238,6 +247,7 @@ def collect(run: Run) -> RunResult:
             "build_time_s": run.build_time_s,
             "robot_model": model,
             "reflected_inertia": reflects_motor_inertia(scenario.robot.reflected_inertia, model),
+            "response": responses_used(signals, scenario.response),
         }
     )
     return RunResult(

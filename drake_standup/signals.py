@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from drake_standup.config import RESPONSES
 from drake_standup.control.controller import DIAGNOSTICS
 from drake_standup.control.schedule import CONTACTS
 from drake_standup.human import HELPER_SPENT
@@ -97,6 +98,11 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
             signals[name] = logs["helper_spent"][:, k]
     if "controller_diagnostics" not in logs:  # the seat-hold benchmark: no controller
         return signals
+    if "response" in logs:  # the robot's response to the pull, as an index of responses
+        signals["response"] = np.rint(logs["response"][:, 0]).astype(np.int8)
+        signals["responses"] = np.array(RESPONSES, dtype=str)
+    if "compliance_W" in logs:  # the compliant response's offset of the CoM reference
+        signals["compliance_offset_W"] = logs["compliance_W"][:, :3]
     reference = COM_REFERENCE.unpack(logs["com_reference"])
     segment = SEGMENT.unpack(logs["segment"])
     diagnostics = DIAGNOSTICS.unpack(logs["controller_diagnostics"])

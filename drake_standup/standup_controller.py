@@ -14,12 +14,13 @@ with its mass estimate (control/model.py, control/mass.py) and the task referenc
 
 Inputs (a station's outputs of the same names, station.py): robot_state, pad_forces_W,
 seat_pad_normal_forces_N, pads_vertical_force_N, hand_wrenches_W (measured), com_W,
-com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, standing_pull_usage; and stand_up (1;
-> 0.5: start; unconnected: never),
-which only the live helper has.
+com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, standing_pull_usage; response (1: the
+response code, config.RESPONSES' index: which of the pull the advancement and the task
+references take, control/references.py); and stand_up (1; > 0.5: start; unconnected:
+never), which only the live helper has.
 Outputs: actuation; controller_diagnostics (control/controller.py: DIAGNOSTICS); psi,
 psi_dot, alpha; com_reference, x_d_W; standup_state, held_back, segment, entry_times_s;
-lean_W; mass_estimate.
+lean_W; compliance_W (the compliant response's offset and rate); mass_estimate.
 """
 
 from __future__ import annotations
@@ -79,6 +80,8 @@ _WIRES = [
     ("task_references", "com_reference", "com_reference", "com_reference"),
     ("task_references", "hand_wrenches_W", "", "hand_wrenches_W"),
     ("task_references", "path_progress", "com_reference", "path_progress"),
+    ("task_references", "response", "", "response"),
+    ("advancement", "response", "", "response"),
     ("controller", "terms", "controller_model", "terms"),
     ("controller", "task_references", "task_references", "task_references"),
     ("controller", "contact_commands", "contact_schedule", "contact_commands"),
@@ -97,6 +100,7 @@ _OUTPUTS = {
     "segment": ("state_machine", "segment"),
     "entry_times_s": ("state_machine", "entry_times_s"),
     "lean_W": ("task_references", "lean_W"),
+    "compliance_W": ("task_references", "compliance_W"),
     "mass_estimate": ("controller_model", "mass_estimate"),
 }
 
@@ -128,7 +132,9 @@ def make_standup_controller(scenario: Scenario, station: Station) -> StandupCont
         "contact_schedule": ContactScheduler(config, table, period_s),
         "controller_model": ControllerModel(plant, robot, specs, config, period_s),
         "task_references": TaskReferenceGenerator(
-            ReferenceGenerator(config, schedule, as_slice(joints.q_indices), period_s, g),
+            ReferenceGenerator(
+                config, schedule, as_slice(joints.q_indices), period_s, g, scenario.compliance
+            ),
             period_s,
         ),
         "controller": WholeBodyController(plant, specs, joints, config, table, period_s),

@@ -12,7 +12,7 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.analysis import Simulator
 
 from drake_standup.advancement import TrajectoryAdvancement, lead, psi_dot_law
-from drake_standup.config import AdvancementConfig
+from drake_standup.config import RESPONSES, AdvancementConfig
 from drake_standup.phases import PhaseTable
 from drake_standup.robot import ContactModel, add_icub
 from drake_standup.sensing import RobotSensing
@@ -92,10 +92,11 @@ def test_interaction_law_value_matches_the_authors_ratio():
     )
 
 
-def _simulate_advancement(cfg, v, omega_f, tangent, t_end, advances=True):
+def _simulate_advancement(cfg, v, omega_f, tangent, t_end, advances=True, response=0):
     system = TrajectoryAdvancement(cfg)
     context = system.CreateDefaultContext()
     system.GetInputPort("advances").FixValue(context, [float(advances)])
+    system.GetInputPort("response").FixValue(context, [float(response)])
     system.GetInputPort("path_progress").FixValue(context, [0.0])  # no taper
     # CoM on its reference: the lead gate is open.
     system.GetInputPort("com_W").FixValue(context, np.zeros(3))
@@ -152,6 +153,26 @@ def test_psi_advances_only_where_the_phase_table_lets_it(state):
     assert system.GetOutputPort("psi_dot_law").Eval(context)[0] == pytest.approx(expected)
     if not advances:
         assert system.GetOutputPort("psi").Eval(context)[0] == pytest.approx(1.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("response", RESPONSES)
+def test_only_the_advancement_response_advances(response):
+    """The same helpful inputs under each response (config.RESPONSES): the law's rate r
+    under advancement; psi = t exactly (psi_dot 1, psi_ddot 0) under stiff and compliant,
+    with alpha still the help along the path."""
+    v = 1.6 * TANGENT
+    omega_f = TANGENT / np.linalg.norm(TANGENT)
+    r = (v @ TANGENT) / (TANGENT @ TANGENT + CFG.eps)
+    code = RESPONSES.index(response)
+    system, context = _simulate_advancement(CFG, v, omega_f, TANGENT, 1.3, response=code)
+    alpha = system.GetOutputPort("alpha").Eval(context)[0]
+    assert alpha == pytest.approx(omega_f @ TANGENT / np.linalg.norm(TANGENT))
+    if response == "advancement":
+        assert system.GetOutputPort("psi_dot_law").Eval(context)[0] == pytest.approx(r)
+        return
+    assert system.GetOutputPort("psi").Eval(context)[0] == pytest.approx(1.3, abs=1e-12)
+    assert system.GetOutputPort("psi_dot").Eval(context)[0] == 1.0
+    assert system.GetOutputPort("psi_ddot").Eval(context)[0] == 0.0
 
 
 def test_graded_gate_weights_the_laws_excess_by_the_help():

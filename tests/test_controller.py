@@ -96,6 +96,7 @@ class _Rig:
             "contact_commands": (model, self.controller),
             "com_reference": (references,),
             "path_progress": (references,),
+            "response": (references,),
         }.items():
             builder.ExportInput(systems[0].GetInputPort(name), name)
             for system in systems[1:]:
@@ -119,6 +120,7 @@ class _Rig:
             "standup_state": [standup_state],
             "com_reference": com_reference,
             "path_progress": [1.0],
+            "response": [0.0],  # advancement's: the help let through
         }
         for name, value in inputs.items():
             self.diagram.GetInputPort(name).FixValue(self.context, value)

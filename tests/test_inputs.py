@@ -131,8 +131,19 @@ BAD = {
         {"list.yaml": "- 1\n- 2\n"},
         [*RUN, "--scenario", "list.yaml"],
         "scenario list.yaml: [1, 2]; accepted: a mapping of robot, duration_s, plant, "
-        "simulator, human, advancement, standup, phases, controller, controller_period_s, "
+        "simulator, human, response, compliance, advancement, standup, phases, controller, "
+        "controller_period_s, "
         "initial, chair, seat_hold, fall, perturbation, visualization, log_period_s",
+    ),
+    "response_unknown": (
+        {},
+        [*RUN, "--set", "response=rigid"],
+        "response: 'rigid' unknown; accepted: advancement | stiff | compliant",
+    ),
+    "compliance_negative_stiffness": (
+        {},
+        [*RUN, "--set", "compliance.stiffness_N_per_m=-5"],
+        "compliance.stiffness_N_per_m: -5.0; accepted: a number > 0",
     ),
     # 2. The chair file (chair.file).
     "chair_missing": (

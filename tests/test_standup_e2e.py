@@ -68,6 +68,39 @@ def test_assisted_stands_up_sooner(assisted, unassisted):
     assert m["standup_time_s"] < m["standup_time_s_without_advancement"]
 
 
+@pytest.fixture(scope="module", params=["stiff", "compliant"])
+def other_response(request, tmp_path_factory):
+    """The assisted scenario's pull answered by stiff or compliant (config.RESPONSES)."""
+    out = tmp_path_factory.mktemp(request.param)
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml", [("response", request.param)])
+    metrics = simulate(scenario, out, record=False, progress=False).metrics
+    return scenario, metrics, load_signals(out / "signals.npz")
+
+
+def test_stiff_and_compliant_keep_psi_equal_to_time(other_response, unassisted):
+    """Under the assisted pull, stiff and compliant stand up with psi = t at every
+    sample; stiff cancels the pull: its stand-up time is the unassisted one within
+    0.05 s; compliant's reference yields, within its bound, and comes back."""
+    scenario, m, sig = other_response
+    assert m["success"], m["failure_reason"]
+    assert m["response"] == scenario.response
+    np.testing.assert_allclose(sig["psi"], sig["time_s"], rtol=0.0, atol=1e-9)
+    assert (sig["psi_dot"] == 1.0).all()
+    assert m["com_final_m"][2] == pytest.approx(m["standing_com_height_m"], abs=0.01)
+    offset = sig["compliance_offset_W"]
+    if scenario.response == "stiff":
+        assert m["standup_time_s"] == pytest.approx(unassisted[1]["standup_time_s"], abs=0.05)
+        assert not offset.any()
+        return
+    bound = np.array(scenario.compliance.max_offset_m)
+    assert (np.abs(offset) <= bound + 1e-12).all()
+    # The 15 + 15 N forward and up pull, at rest: F/K on x and z (inside the bound).
+    K = scenario.compliance.stiffness_N_per_m
+    plateau = (sig["time_s"] > 7.0) & (sig["time_s"] < 10.5)  # full pull 3.5-10.5 s
+    np.testing.assert_allclose(offset[plateau][:, [0, 2]], 30.0 / K, rtol=1e-3)
+    assert np.abs(offset[-1]).max() < 1e-4  # back on the path 4 s after the pull ended
+
+
 @pytest.fixture(scope="module")
 def reactive(tmp_path_factory):
     out = tmp_path_factory.mktemp("reactive")

@@ -18,6 +18,9 @@ from drake_standup.config.inputs import TASK_FRAMES
 from drake_standup.control.model import HANDS, ControllerJoints
 from drake_standup.control.qp import as_slice
 from drake_standup.control.references import (
+    ADVANCEMENT,
+    COMPLIANT,
+    STIFF,
     ReferenceGenerator,
     StandupSchedule,
     TaskReferenceGenerator,
@@ -96,7 +99,18 @@ def test_the_schedule_is_the_phase_tables(rig):
     assert schedule[2].posture_rad[k] > TABLE.forward.posture_rad["l_elbow"]
 
 
-def _calc(rig, state, *, reference=None, hands=None, integral=None, progress=1.0, lean=None):
+def _calc(
+    rig,
+    state,
+    *,
+    reference=None,
+    hands=None,
+    integral=None,
+    progress=1.0,
+    lean=None,
+    response=ADVANCEMENT,
+    compliance=None,
+):
     terms = rig["kinematics"].calc(rig["x"], [], HANDS if hands is not None else ())
     nu = len(rig["joints"].names)
     p, v, _, _ = _drake_com(rig)
@@ -112,6 +126,8 @@ def _calc(rig, state, *, reference=None, hands=None, integral=None, progress=1.0
         lean,
         progress,
         0.0,
+        response,
+        compliance,
     ), reference
 
 
@@ -145,6 +161,86 @@ def test_the_help_let_through_is_the_pull_along_the_desired_velocity(rig):
     terms = rig["kinematics"].calc(rig["x"], [], HANDS)
     J = np.concatenate([terms.J_W[0], terms.J_W[1]])
     np.testing.assert_allclose(pulled.tau_hand, J.T @ hands, atol=1e-12)
+
+
+@pytest.mark.parametrize("response", [STIFF, COMPLIANT])
+def test_stiff_and_compliant_compensate_the_whole_pull(rig, response):
+    """The pull of the test above under stiff and compliant: no help passes, so the
+    linear momentum target is the CoM law's alone (the pull is compensated in full, the
+    QP having it in the dynamics); the hands' generalized force is the same."""
+    p, _, _, _ = _drake_com(rig)
+    reference = np.concatenate([p, [0.1, 0.0, 0.0], np.zeros(3)])
+    hands = np.tile([0.0, 0.0, 0.0, 15.0, 0.0, 15.0], 2)
+    alone, _ = _calc(rig, 2, reference=reference)
+    pulled, _ = _calc(rig, 2, reference=reference, hands=hands, response=response)
+    assert not pulled.helpful_force_W.any()
+    helped, _ = _calc(rig, 2, reference=reference, hands=hands)
+    np.testing.assert_allclose(pulled.tau_hand, helped.tau_hand, atol=0.0)
+    if response == STIFF:
+        np.testing.assert_allclose(pulled.Ldot_star, alone.Ldot_star, atol=1e-12)
+        assert not pulled.next_compliance.any()
+
+
+def _admittance_run(rig, force, ticks):
+    """The compliant response's offset and rate over ticks under a constant total hand
+    force (N, W), state 2, the reference fixed."""
+    hands = np.concatenate([[0.0, 0.0, 0.0], force / 2.0, [0.0, 0.0, 0.0], force / 2.0])
+    state, trace = np.zeros(6), []
+    for _ in range(ticks):
+        references, _ = _calc(rig, 2, hands=hands, response=COMPLIANT, compliance=state)
+        state = references.next_compliance
+        trace.append(state)
+    return np.array(trace)
+
+
+def test_the_compliant_reference_follows_the_admittance(rig):
+    """A 10 N forward step (inside the bound): the offset follows M x'' + D x' + K x = F,
+    critically damped, x(t) = F/K (1 - (1 + w t) e^(-w t)), w = sqrt(K/M), to the
+    semi-implicit Euler's O(T) error; it settles at F/K without overshoot; the reference
+    the CoM law tracks moves by the offset and its rate."""
+    compliance = Scenario().compliance
+    M, K = compliance.virtual_mass_kg, compliance.stiffness_N_per_m
+    w = math.sqrt(K / M)
+    F = np.array([10.0, 0.0, 0.0])
+    trace = _admittance_run(rig, F, 1000)  # 4 s, 20 time constants
+    t = T * np.arange(1, 1001)
+    exact = F[0] / K * (1.0 - (1.0 + w * t) * np.exp(-w * t))
+    # The step's error: a fraction w T (2.5 %) of the response's amplitude F/K.
+    np.testing.assert_allclose(trace[:, 0], exact, atol=w * T * F[0] / K)
+    assert trace[:, 0].max() <= F[0] / K * (1.0 + 1e-3)  # no overshoot (to the step's error)
+    assert trace[-1, 0] == pytest.approx(F[0] / K, rel=1e-6)
+    assert not trace[:, 1:3].any()  # no force sideways or up: no offset there
+
+
+def test_the_compliant_offset_is_held_within_its_bound(rig):
+    """A pull far beyond the bound (100 N forward, 100 N down): each axis' offset stops at
+    compliance.max_offset_m, with no rate outward there."""
+    bound = np.array(Scenario().compliance.max_offset_m)
+    trace = _admittance_run(rig, np.array([100.0, 0.0, -100.0]), 500)
+    assert (np.abs(trace[:, :3]) <= bound + 1e-15).all()
+    np.testing.assert_allclose(trace[-1, :3], [bound[0], 0.0, -bound[2]], atol=0.0)
+    np.testing.assert_array_equal(trace[-1, 3:], np.zeros(3))
+
+
+def test_the_compliant_offset_returns_once_the_pull_stops(rig):
+    """From a held offset and no pull, the admittance takes the reference back to the
+    path: after 4 s (20 time constants) within 1 um, never past it (critically damped)."""
+    state, trace = np.array([0.03, 0.0, 0.0, 0.0, 0.0, 0.0]), []
+    for _ in range(1000):
+        references, _ = _calc(rig, 2, response=COMPLIANT, compliance=state)
+        state = references.next_compliance
+        trace.append(state[0])
+    assert abs(trace[-1]) < 1e-6
+    assert min(trace) > -1e-6
+    # The CoM law tracks x_d + x, xd_dot + x', xd_ddot + x'' (x'' the tick's change of x').
+    held = np.array([0.03, 0.0, 0.0, 0.0, 0.0, 0.0])
+    moved, _ = _calc(rig, 2, response=COMPLIANT, compliance=held)
+    still, _ = _calc(rig, 2)
+    x, v = moved.next_compliance[:3], moved.next_compliance[3:]
+    kp = np.array(TABLE.forward.com_kp_per_s2)
+    _, _, _, m = _drake_com(rig)
+    expected = m * ((v - held[3:]) / T + 2.0 * CONFIG.com_damping_ratio * np.sqrt(kp) * v + kp * x)
+    np.testing.assert_allclose(moved.Ldot_star[3:] - still.Ldot_star[3:], expected, atol=1e-9)
 
 
 def test_the_stance_hands_the_height_to_the_legs(rig):
@@ -231,6 +327,7 @@ def test_the_generator_integrates_the_angular_momentum_over_its_ticks(rig):
     system.GetInputPort("com_reference").FixValue(context, np.concatenate([p, np.zeros(6)]))
     system.GetInputPort("hand_wrenches_W").FixValue(context, np.zeros(12))
     system.GetInputPort("path_progress").FixValue(context, [0.0])
+    system.GetInputPort("response").FixValue(context, [float(ADVANCEMENT)])
     simulator = Simulator(system, context)
     simulator.AdvanceTo(2.5 * T)
     integral = context.get_discrete_state(0).value()

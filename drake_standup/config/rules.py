@@ -18,7 +18,7 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 from drake_standup.config.controller import QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
-from drake_standup.config.scenario import REFLECTED_INERTIA, Scenario
+from drake_standup.config.scenario import REFLECTED_INERTIA, RESPONSES, Scenario
 from drake_standup.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
 
 
@@ -65,6 +65,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (("velocity", "path"), "human.reactive.guide"),
     (("tangent", "interaction"), "advancement.law"),
     (REFLECTED_INERTIA, "robot.reflected_inertia"),
+    (RESPONSES, "response"),
     (("hands", "time"), "standup.trigger"),
     (SEAT_HOLDS, "phases.*.seat_hold phases.*.seat_hold_sat_back"),
     (SEAT_PADS, "phases.*.unload[*]"),
@@ -85,7 +86,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "controller.momentum_weight controller.*_time_constant_s "
         "controller.joint_limit_horizon_s controller.*friction_coefficient* "
         "controller.*_max_normal_force_N controller.torque_limit_Nm controller.help_* "
-        "controller.mass_scale_bounds "
+        "controller.mass_scale_bounds compliance.virtual_mass_kg compliance.stiffness_N_per_m "
         "fall.max_com_horizontal_m perturbation.pushes[*].duration_s perturbation.*_scale "
         "perturbation.hand_wrench_noise_period_s plant.penetration_allowance "
         "plant.stiction_tolerance simulator.accuracy",
@@ -101,6 +102,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "controller.*_weight controller.contact_velocity_gain_per_s "
         "controller.*weight_by_joint.* controller.*_kp_* controller.*_kd_* controller.*_ki_* "
         "controller.*_damping_ratio controller.posture_limit_margin_rad controller.*_N "
+        "compliance.damping_ratio compliance.max_offset_m "
         "controller.lean_max_* controller.mass_estimation_filter_s seat_hold.* "
         "fall.max_qp_failure_streak_s "
         "perturbation.pushes[*].start_s perturbation.hand_wrench_noise_N "
@@ -124,7 +126,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         3,
         "initial.base_* visualization.*_xyz_m chair.xyz_m human.pulls[*].force_N "
         "human.reactive.target_velocity_mps phases.*.com_delta_m phases.*.com_kp_per_s2 "
-        "perturbation.pushes[*].force_N",
+        "perturbation.pushes[*].force_N compliance.max_offset_m",
     ),
     (
         INTERVAL,

@@ -46,6 +46,9 @@ def _seated_joints() -> dict[str, float]:
 
 # robot.reflected_inertia's settings (robot.reflects_motor_inertia).
 REFLECTED_INERTIA = ("none", "all", "real_robots")
+# response's settings, the robot's answer to a pull (SPEC 1; the paper's introduction names
+# the three): its index is the response code the controller's systems read.
+RESPONSES = ("advancement", "stiff", "compliant")
 
 
 @dataclass
@@ -208,6 +211,30 @@ class AdvancementConfig:
 
 
 @dataclass
+class ComplianceConfig:
+    """The CoM reference's admittance for response: compliant (control/references.py):
+
+        M a + D v + K x = f_hands,   D = 2 zeta sqrt(K M),
+
+    x the reference's offset (W), f_hands the measured pull of both hands. Bounded so the
+    robot stays over its support: each axis within max_offset_m."""
+
+    # The robot's own mass (iCubGazeboV2_5: 33 kg): the reference yields to the pull as
+    # the robot itself would, free, at first (Omega f = f / m, SPEC 2). kg.
+    virtual_mass_kg: float = 33.0
+    # The top of a realistic helper's envelope, 2 x 26 N (SPEC 9: an untrained person's
+    # peak per hand), reaches the forward bound: 52 N / 0.04 m. A trained helper's
+    # 13 + 10 N (SPEC 9) yields 1.8 cm. N/m.
+    stiffness_N_per_m: float = 1300.0
+    # Critically damped: the offset follows a steady pull without overshoot.
+    damping_ratio: float = 1.0
+    # x, y, z. Forward and back 4 cm: inside the 6.8 cm from the standing CoM to the toes
+    # and the 8.2 cm to the heels (issue 21, docs/results.md); sideways and up or down
+    # 3 cm. m.
+    max_offset_m: list[float] = field(default_factory=lambda: [0.04, 0.03, 0.03])
+
+
+@dataclass
 class StandupConfig:
     """The state machine's settings across phases (SPEC 3, 7); what each state does, and
     the guard that leaves it, is the phase table (phases.py). Reasons: docs/design.md."""
@@ -366,6 +393,12 @@ class Scenario:
         )
     )
     human: HumanConfig = field(default_factory=HumanConfig)
+    # How the robot answers the pull (RESPONSES): advancement, the paper's (psi runs ahead
+    # while the pull helps, by advancement.law); stiff, psi = t and the pull compensated in
+    # full, the CoM tracking its time reference as if nobody pulled; compliant, psi = t and
+    # the CoM reference yielding to the pull through an admittance (compliance).
+    response: str = "advancement"
+    compliance: ComplianceConfig = field(default_factory=ComplianceConfig)
     advancement: AdvancementConfig = field(default_factory=AdvancementConfig)
     standup: StandupConfig = field(default_factory=StandupConfig)
     # What each stand-up state does and the guard that leaves it (phases.py).

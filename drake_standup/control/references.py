@@ -29,6 +29,15 @@ as the CoM runs ahead of its reference:
     f_par = s(||xd_dot|| / v_fade) (1 - s(lead / lead_max)) max(0, f_h . u) u,
     u = xd_dot / ||xd_dot||,  lead = (x - x_d) . u,  s = smoothstep (3 r^2 - 2 r^3 on [0, 1]).
 
+The robot's response to the pull (scenario response, config.RESPONSES) sets what of it
+acts: advancement lets f_par through (above); stiff and compliant compensate the whole pull
+(f_par = 0), and compliant moves the CoM reference by the offset x of an admittance,
+
+    M xddot + D xdot + K x = f_h,   each axis of x within compliance.max_offset_m,
+
+integrated each tick (semi-implicit Euler), its rate and acceleration added to the
+reference's; it returns to zero when the pull, or the compliant response, stops.
+
 The posture reference and the base's target orientation:
 
     q_ref  <- q_ref + (T / tau_f) (q_target - q_ref)      first-order filter, period T
@@ -36,14 +45,14 @@ The posture reference and the base's target orientation:
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import Value
 from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
 from drake_standup.caching import declare_cached
-from drake_standup.config import ControllerConfig
+from drake_standup.config import RESPONSES, ComplianceConfig, ControllerConfig
 from drake_standup.control.spatial import yaw_pitch_rotation
 from drake_standup.control.terms import RobotTerms
 from drake_standup.payloads import COM_REFERENCE, HAND_WRENCHES
@@ -51,6 +60,8 @@ from drake_standup.phases import PhaseTable
 from drake_standup.reference import smoothstep
 
 STATES = (1, 2, 3, 4)
+# The response codes (the index in config.RESPONSES) the controller's systems read.
+ADVANCEMENT, STIFF, COMPLIANT = (RESPONSES.index(name) for name in RESPONSES)
 
 
 def com_acceleration_reference(
@@ -170,6 +181,8 @@ class TaskReferences:
     # The posture state after this tick: [latched flag, first tick's posture (nu),
     # q_ref's next value (nu), first tick's base yaw].
     next_posture: np.ndarray
+    # The admittance's [offset (3), rate (3)] after this tick (response compliant), m, m/s.
+    next_compliance: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
 
 def static_lean(
@@ -208,12 +221,22 @@ class ReferenceGenerator:
         q_joints: slice | np.ndarray,
         period_s: float,
         gravity_mps2: float = 0.0,
+        compliance: ComplianceConfig | None = None,
     ):
         """q_joints: the actuated joints' entries of q, in the schedule's order;
         gravity_mps2: g, the plant's. The robot's weight is that of the model the terms
         are computed with (terms.mass_kg g: the controller's estimate once it has
         weighed the robot), for the lean against the pull and the height integral's
-        bound."""
+        bound. compliance: the admittance of the compliant response (default: its
+        defaults)."""
+        compliance = compliance or ComplianceConfig()
+        mass, stiffness = compliance.virtual_mass_kg, compliance.stiffness_N_per_m
+        self._admittance = (
+            mass,
+            2.0 * compliance.damping_ratio * math.sqrt(stiffness * mass),
+            stiffness,
+            np.array(compliance.max_offset_m),
+        )
         self._config = config
         self.schedule = schedule
         self._q_joints = q_joints
@@ -258,6 +281,22 @@ class ReferenceGenerator:
             return lean
         return lean + self._lean_blend * (target - lean)
 
+    def _yield(self, f_hand_W: np.ndarray | None, compliance: np.ndarray) -> np.ndarray:
+        """The admittance's next [offset, rate] (6,) from this tick's [offset, rate] under
+        the hands' total force f_hand_W (N; None: no pull, or not compliant): semi-implicit
+        Euler, the offset held within its bound with no rate outward there."""
+        mass, damping, stiffness, bound = self._admittance
+        x, v = compliance[:3], compliance[3:]
+        force = -damping * v - stiffness * x
+        if f_hand_W is not None:
+            force += f_hand_W
+        v_next = v + (self._period_s / mass) * force
+        x_next = x + self._period_s * v_next
+        held = np.clip(x_next, -bound, bound)
+        outward = (held != x_next) & (v_next * x_next > 0.0)
+        v_next[outward] = 0.0
+        return np.concatenate((held, v_next))
+
     def calc(
         self,
         terms: RobotTerms,
@@ -269,13 +308,17 @@ class ReferenceGenerator:
         lean_W: np.ndarray | None = None,
         path_progress: float = 1.0,
         height_integral: float = 0.0,
+        response: int = ADVANCEMENT,
+        compliance: np.ndarray | None = None,
     ) -> TaskReferences:
         """com_reference = [x_d, xd_dot, xd_ddot] (9,); F_hand_W = [tau_l, f_l, tau_r, f_r]
         (None: no pull); momentum_integral = int L_ang dt; posture: the posture state
         before this tick (TaskReferences.next_posture); lean_W: the lean's filtered value
         before this tick (None: zero); path_progress: how far along its segment the CoM
         reference is, 0-1; height_integral: the stance's integral of the CoM height
-        error before this tick, m s."""
+        error before this tick, m s; response: ADVANCEMENT, STIFF or COMPLIANT (which of
+        the pull acts, module docstring); compliance: the admittance's [offset, rate]
+        before this tick (None: at rest)."""
         config = self._config
         state = self.schedule[standup_state]
         tau_hand = None if F_hand_W is None else terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
@@ -288,6 +331,19 @@ class ReferenceGenerator:
             height = com_reference[2]
             com_reference[:2] += lean[:2]
             com_reference[2] = math.sqrt(max(height * height - lean[0] ** 2 - lean[1] ** 2, 0.0))
+        compliance = np.zeros(6) if compliance is None else compliance
+        pulled = F_hand_W is not None and response == COMPLIANT
+        next_compliance = compliance
+        if pulled or compliance.any():
+            next_compliance = self._yield(
+                F_hand_W[3:6] + F_hand_W[9:12] if pulled else None, compliance
+            )
+            com_reference = com_reference + np.concatenate(
+                (
+                    next_compliance,
+                    (next_compliance[3:] - compliance[3:]) / self._period_s,
+                )
+            )
         xddot_star = com_acceleration_reference(
             terms.p_WCom, terms.v_WCom, com_reference, state.com_kp_per_s2, state.com_kd_per_s
         )
@@ -320,7 +376,7 @@ class ReferenceGenerator:
             )
             Ldot_star[5] += terms.mass_kg * ki * next_height_integral
         f_par = np.zeros(3)
-        if F_hand_W is not None:
+        if F_hand_W is not None and response == ADVANCEMENT:
             xd_dot = com_reference[3:6]
             speed = math.sqrt(float(xd_dot @ xd_dot))
             lead_m = (terms.p_WCom - com_reference[:3]) @ xd_dot / speed if speed > 0.0 else 0.0
@@ -369,6 +425,7 @@ class ReferenceGenerator:
             vertical_weight_scale=vertical_weight_scale,
             stance=stance,
             next_height_integral=next_height_integral,
+            next_compliance=next_compliance,
             next_momentum_integral=momentum_integral + self._period_s * terms.L_WCom[:3],
             next_posture=np.concatenate((self._latched, q_initial, q_next, (base_yaw,))),
         )
@@ -379,10 +436,12 @@ class TaskReferenceGenerator(LeafSystem):
 
     Inputs: terms (abstract RobotTerms, control/model.py), standup_state (1),
     com_reference (9, payloads.COM_REFERENCE), hand_wrenches_W (12), path_progress (1:
-    how far along its segment the CoM reference is, 0-1). Outputs: task_references (abstract
-    TaskReferences) and lean_W (3: the CoM target's lean after the last tick, m).
-    Discrete state: the angular momentum's integral (3, N m s^2), the posture state
-    (TaskReferences.next_posture), the lean (3, m), the stance's height integral (1, m s).
+    how far along its segment the CoM reference is, 0-1), response (1: the response code,
+    ADVANCEMENT, STIFF or COMPLIANT). Outputs: task_references (abstract TaskReferences),
+    lean_W (3: the CoM target's lean after the last tick, m) and compliance_W (6: the
+    admittance's offset and rate after the last tick, m, m/s). Discrete state: the angular
+    momentum's integral (3, N m s^2), the posture state (TaskReferences.next_posture), the
+    lean (3, m), the stance's height integral (1, m s), the admittance (6).
     """
 
     def __init__(self, generator: ReferenceGenerator, period_s: float):
@@ -395,11 +454,13 @@ class TaskReferenceGenerator(LeafSystem):
         self._reference = self.DeclareVectorInputPort("com_reference", COM_REFERENCE.size)
         self._hands = self.DeclareVectorInputPort("hand_wrenches_W", HAND_WRENCHES.size)
         self._progress = self.DeclareVectorInputPort("path_progress", 1)
+        self._response = self.DeclareVectorInputPort("response", 1)
         self._integral = self.DeclareDiscreteState(3)
         # [latched flag, state-1 posture (nu), filtered posture reference (nu), base yaw].
         self._posture = self.DeclareDiscreteState(2 + 2 * nu)
         self._lean = self.DeclareDiscreteState(3)
         self._height_integral = self.DeclareDiscreteState(1)
+        self._compliance = self.DeclareDiscreteState(6)
         self._references = declare_cached(
             self, "task references", self._calc, {self.all_sources_ticket()}
         )
@@ -410,6 +471,7 @@ class TaskReferenceGenerator(LeafSystem):
             {self._references.ticket()},
         )
         self.DeclareStateOutputPort("lean_W", self._lean)
+        self.DeclareStateOutputPort("compliance_W", self._compliance)
         self.DeclareInitializationDiscreteUpdateEvent(self._Update)
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
 
@@ -428,6 +490,8 @@ class TaskReferenceGenerator(LeafSystem):
             state.get_value(self._lean),
             progress,
             float(state.get_value(self._height_integral)[0]),
+            int(round(self._response.Eval(context)[0])),
+            state.get_value(self._compliance),
         )
 
     def _CalcReferences(self, context: Context, output: Value) -> None:
@@ -439,3 +503,4 @@ class TaskReferenceGenerator(LeafSystem):
         discrete_state.set_value(self._posture, references.next_posture)
         discrete_state.set_value(self._lean, references.lean_W)
         discrete_state.set_value(self._height_integral, [references.next_height_integral])
+        discrete_state.set_value(self._compliance, references.next_compliance)
