@@ -6,7 +6,9 @@ The scenario's human is replaced by LiveHumanSource: the pull on each hand comes
 Meshcat sliders (forward and up, N, within +-human.reactive.force_cap_N, the helper's
 cap per hand), one switch pulls both hands together (the left hand's sliders drive
 both), and a standard gamepad, once the page has seen it, drives the pull from its
-sticks. "Stand up" starts the stand-up where standup.trigger waits for the hands,
+sticks. A slider switches the robot's response to the pull (advancement, stiff,
+compliant: config.RESPONSES) while the run goes on, so that the same pull can be felt
+answered each way. "Stand up" starts the stand-up where standup.trigger waits for the hands,
 "Reset" puts the robot back on the chair (also after a fall, which in a live run is
 reported on the console instead of ending it), "Stop" (or Escape, or Ctrl-C) ends the
 run.
@@ -41,7 +43,7 @@ from pydrake.systems.framework import (
     LeafSystem,
 )
 
-from drake_standup.config import HumanConfig, Scenario
+from drake_standup.config import RESPONSES, HumanConfig, Scenario
 from drake_standup.diagram import on_step_grid
 from drake_standup.human import hand_forces, spatial_forces
 from drake_standup.outputs import write_run
@@ -54,6 +56,8 @@ AXES = ("fwd", "up")  # world x (the robot faces +x) and z
 # Short labels: Meshcat's control panel cuts a label at ~15 characters.
 SLIDERS = {(hand, axis): f"{hand} {axis} (N)" for hand in HANDS for axis in AXES}
 TOGETHER = "both hands"
+# The response switch: 0, 1, 2 in the order of config.RESPONSES (15 characters).
+RESPONSE = "adv/stiff/compl"
 STAND_UP = "Stand up"
 RESET = "Reset"
 STOP = "Stop"
@@ -89,12 +93,13 @@ def gamepad_pull(axes: list[float], cap_N: float) -> np.ndarray:
 class LiveHumanSource(LeafSystem):
     """The helper at the Meshcat page: HumanWrenchSource's ports (input robot_state,
     unused; outputs hand_wrenches_W and spatial_forces) plus stand_up (1: the "Stand
-    up" button was pressed since the last reset).
+    up" button was pressed since the last reset) and response (1: the response switch's
+    code, RESPONSES' index; starts at response).
 
     Every period_s (the plant's step) a discrete update reads the page (sliders, the
-    switch, the gamepad, the button) into the state [f_left (3), f_right (3),
-    stand_up], world frame, N: so the pull reaches the plant within a step, and the
-    run's signals hold what the helper did.
+    switches, the gamepad, the button) into the state [f_left (3), f_right (3),
+    stand_up, response], world frame, N: so the pull reaches the plant within a step,
+    and the run's signals hold what the helper did.
     """
 
     def __init__(
@@ -105,6 +110,7 @@ class LiveHumanSource(LeafSystem):
         meshcat: Meshcat,
         period_s: float,
         stand_up_button: bool = True,
+        response: int = 0,
     ):
         super().__init__()
         self._meshcat = meshcat
@@ -113,7 +119,8 @@ class LiveHumanSource(LeafSystem):
         self._clicks_seen = 0
         self._applied = hand_forces(plant, robot)
         self.DeclareVectorInputPort("robot_state", plant.num_multibody_states(robot.model_instance))
-        self._index = self.DeclareDiscreteState(7)
+        self._response = response
+        self._index = self.DeclareDiscreteState(np.r_[np.zeros(7), float(response)])
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
         state = {self.discrete_state_ticket(self._index)}
         self.DeclareVectorOutputPort(
@@ -126,6 +133,7 @@ class LiveHumanSource(LeafSystem):
             prerequisites_of_calc=state,
         )
         self.DeclareVectorOutputPort("stand_up", 1, self._CalcStandUp, prerequisites_of_calc=state)
+        self.DeclareVectorOutputPort("response", 1, self._CalcResponse, prerequisites_of_calc=state)
         self._add_controls()
 
     def _add_controls(self) -> None:
@@ -133,6 +141,7 @@ class LiveHumanSource(LeafSystem):
         for name in SLIDERS.values():
             m.AddSlider(name, -self._cap, self._cap, SLIDER_STEP_N, 0.0)
         m.AddSlider(TOGETHER, 0.0, 1.0, 1.0, 1.0)
+        m.AddSlider(RESPONSE, 0.0, len(RESPONSES) - 1.0, 1.0, float(self._response))
         if self._stand_up_button:
             m.AddButton(STAND_UP)
 
@@ -174,10 +183,18 @@ class LiveHumanSource(LeafSystem):
             asked = asked or m.GetButtonClicks(STAND_UP) > self._clicks_seen
         return np.column_stack([pull[:, 0], np.zeros(2), pull[:, 1]]), asked
 
+    def read_response(self) -> int:
+        """The response switch's code (RESPONSES' index), as the page says now."""
+        code = round(self._meshcat.GetSliderValue(RESPONSE))
+        return min(max(code, 0), len(RESPONSES) - 1)
+
     def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
         forces, asked = self.read_page()
         latched = context.get_discrete_state(self._index).GetAtIndex(6) > 0.5
-        discrete_state.set_value(self._index, np.r_[forces.ravel(), float(latched or asked)])
+        discrete_state.set_value(
+            self._index,
+            np.r_[forces.ravel(), float(latched or asked), float(self.read_response())],
+        )
 
     def _state(self, context: Context) -> np.ndarray:
         return context.get_discrete_state(self._index).value()
@@ -195,6 +212,9 @@ class LiveHumanSource(LeafSystem):
 
     def _CalcStandUp(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, self._state(context)[6])
+
+    def _CalcResponse(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self._state(context)[7])
 
 
 def make_live_meshcat() -> Meshcat:
@@ -224,6 +244,7 @@ class LiveSession:
         self._fall = None
         self.interrupted = False  # Ctrl-C (set by the signal handler)
         self.resets = 0
+        self._response = scenario.response  # the switch's last reported setting
         self._initial_state = None
         self._reset_clicks = 0
 
@@ -238,6 +259,7 @@ class LiveSession:
             self.meshcat,
             step,
             stand_up_button=self._scenario.standup.trigger == "hands",
+            response=RESPONSES.index(self._scenario.response),
         )
         # Below the helper's controls.
         self.meshcat.AddButton(RESET)
@@ -301,6 +323,10 @@ class LiveSession:
             self.reset(run)
             self._restart_clocks(simulator)
             return False
+        response = RESPONSES[self.human.read_response()]
+        if response != self._response:
+            self._response = response
+            self._report(f"t = {run.time_s:.2f} s: the robot's response is now {response}")
         self._pace(simulator)
         return False
 

@@ -18,6 +18,7 @@ from drake_standup.diagram import build_diagram
 from drake_standup.human import HumanWrenchSource
 from drake_standup.live import (
     RESET,
+    RESPONSE,
     SLIDERS,
     STAND_UP,
     STOP,
@@ -250,6 +251,50 @@ def test_a_helpful_slider_pull_advances_psi_and_a_backward_one_does_not():
     assert backward["state"].max() >= 3  # the robot rose against the pull
     assert backward["psi_dot"].min() == 1.0 and backward["psi_dot"].max() == 1.0
     np.testing.assert_array_equal(backward["psi"], backward["time_s"])
+
+
+class _Switching(_Pulling):
+    """A helper who pulls 15 + 15 N on both hands from the start and, once the robot has
+    risen onto its feet (state 3), moves the response switch to stiff."""
+
+    def __init__(self, scenario):
+        super().__init__(scenario, (15.0, 15.0))
+        self.lines = []
+        self._report = self.lines.append
+        self.switched_at = None
+
+    def after_chunk(self, run) -> bool:
+        state = run.built.output("standup_state", run.simulator.get_context())[0]
+        if self.switched_at is None and state >= 3:
+            self.meshcat.SetSliderValue(RESPONSE, 1.0)  # stiff
+            self.switched_at = run.time_s
+        return super().after_chunk(run)
+
+
+@pytest.mark.slow
+def test_the_response_switch_stops_the_advancement_on_the_same_pull():
+    """The same pull, the switch moved from advancement to stiff mid-rise: the diagram's
+    response follows within a plant step, psi_dot, which the help had run past 1, then
+    only decays toward 1 (its filter, advancement.psi_ddot_filter_s), reaching it within
+    10 filter time constants; the console names the new response once."""
+    scenario = _quick("time")
+    scenario.duration_s = 3.0
+    scenario.simulator.target_realtime_rate = 0.0
+    session = _Switching(scenario)
+    sig = run_session(scenario, session).signals
+    t, switched = sig["time_s"], session.switched_at
+    assert switched is not None
+    assert (sig["response"][t < switched] == 0).all()
+    after = t >= switched + scenario.plant.time_step
+    assert (sig["response"][after] == 1).all() and after.any()
+    assert sig["psi_dot"][t < switched].max() > 1.2  # advancing before the switch
+    psi_dot = sig["psi_dot"][after]
+    assert (np.diff(psi_dot) <= 1e-12).all()  # no more advancing: only the filter's decay
+    settled = t >= switched + 10 * scenario.advancement.psi_ddot_filter_s
+    assert sig["psi_dot"][settled] == pytest.approx(1.0, abs=1e-4)
+    assert [line for line in session.lines if "response" in line] == [
+        f"t = {switched:.2f} s: the robot's response is now stiff"
+    ]
 
 
 class _Toppling(_Pulling):
