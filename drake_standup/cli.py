@@ -1,7 +1,7 @@
 """The command line: `drake-standup COMMAND` (also `python -m drake_standup COMMAND`).
 
-Commands: run (one scenario: recording, metrics, figures), sweep, bench, convergence and
-scenarios (what the package ships). Each command's module does the work; this one parses
+Commands: run (one scenario: recording, metrics, figures), sweep, compare (the robot's
+responses side by side), bench, convergence and scenarios (what the package ships). Each command's module does the work; this one parses
 arguments and turns a bad input into one 'error:' line and exit code 2. No heavy imports
 here: a command parses its arguments before it loads Drake.
 """
@@ -20,6 +20,7 @@ COMMANDS = {
     "run": ("drake_standup.cli", "simulate one scenario: recording, metrics, figures"),
     "live": ("drake_standup.cli", "be the helper: run paced at real time, pull from the page"),
     "sweep": ("drake_standup.sweep", "many runs on Dask: a grid, random draws, perturbations"),
+    "compare": ("drake_standup.compare", "advancement, stiff and compliant on the same helpers"),
     "bench": ("drake_standup.bench", "how fast the stand-up simulates, and where time goes"),
     "convergence": ("drake_standup.convergence", "the plant-step convergence study"),
     "scenarios": ("drake_standup.cli", "list the shipped scenarios and sweeps"),

@@ -253,7 +253,7 @@ def _draw(rng: np.random.Generator, draw):
     return args[min(int(u * len(args)), len(args) - 1)]
 
 
-def _run_id(base_text: str, overrides: list) -> str:
+def run_key(base_text: str, overrides: list) -> str:
     """Names a run by what it simulates: base scenario and overrides."""
     payload = json.dumps({"base": base_text, "overrides": overrides}, sort_keys=True)
     return hashlib.sha1(payload.encode()).hexdigest()[:12]
@@ -286,7 +286,7 @@ def expand(spec: SweepSpec) -> list[RunSpec]:
         ]
         overrides += _perturbations(rng, spec.perturbations, params)
         _checked(f"run {index} ({params})", apply_overrides, base, overrides)
-        runs.append(RunSpec(index, _run_id(spec.base_text, overrides), params, overrides))
+        runs.append(RunSpec(index, run_key(spec.base_text, overrides), params, overrides))
     return runs
 
 

@@ -349,6 +349,23 @@ BAD = {
         "perturbation.pushes[0].body: 'spine' unknown; accepted: the bodies of "
         "iCubGazeboV2_5 reduced: {bodies}",
     ),
+    # 6. The comparison of responses (drake-standup compare).
+    "compare_unknown_helper": (
+        {},
+        ["compare", "--helpers", "nobody"],
+        "--helpers: file 'nobody' not found; accepted: a scenario YAML file, a shipped "
+        "scenario ({scenarios}) or SWEEP#K, run K of a sweep ({sweeps})",
+    ),
+    "compare_run_beyond_the_sweep": (
+        {},
+        ["compare", "--helpers", "helpers#48"],
+        "--helpers helpers#48: run '48' of sweep helpers; accepted: 0 to 47",
+    ),
+    "compare_unknown_response": (
+        {},
+        ["compare", "--responses", "stiff", "rigid"],
+        "--responses rigid: unknown; accepted: advancement | stiff | compliant",
+    ),
 }
 # One of each kind through `python -m drake_standup` in a fresh process as well.
 IN_A_FRESH_PROCESS = [
@@ -360,6 +377,7 @@ IN_A_FRESH_PROCESS = [
     "continuous_plant",
     "model_iCubGenova03",
     "unknown_seat_hinge_joint",
+    "compare_run_beyond_the_sweep",
 ]
 
 
