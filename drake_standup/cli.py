@@ -1,9 +1,10 @@
 """The command line: `drake-standup COMMAND` (also `python -m drake_standup COMMAND`).
 
 Commands: run (one scenario: recording, metrics, figures), sweep, compare (the robot's
-responses side by side), bench, convergence and scenarios (what the package ships). Each command's module does the work; this one parses
-arguments and turns a bad input into one 'error:' line and exit code 2. No heavy imports
-here: a command parses its arguments before it loads Drake.
+responses side by side), bench, convergence and scenarios (what the package ships).
+Each command's module does the work; this one parses arguments and turns a bad input
+into one 'error:' line and exit code 2. No heavy imports here: a command parses its
+arguments before it loads Drake.
 """
 
 from __future__ import annotations
