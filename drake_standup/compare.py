@@ -18,7 +18,6 @@ OUT/comparison.png (the same four quantities per helper and response).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
@@ -140,48 +139,22 @@ def run_compare(
 ) -> list[dict]:
     """Simulates what out_dir/runs/ does not hold yet; writes the table, Markdown and
     figure; returns the records (params, metrics) in helper-then-response order."""
-    from drake_standup.cluster import run_on_cluster
-    from drake_standup.records import write_json
-    from drake_standup.sweep import run_one
+    from drake_standup.sweep import run_one, run_resumable
 
-    out_dir = Path(out_dir)
-    runs_dir = out_dir / "runs"
-    runs_dir.mkdir(parents=True, exist_ok=True)
     runs = _runs(helpers, responses)
-    records = {}
-    for run in runs:
-        path = runs_dir / f"{run['run_id']}.json"
-        if path.is_file():
-            record = json.loads(path.read_text())
-            if not record.get("retry"):
-                records[run["run_id"]] = record
-    todo = [run for run in runs if run["run_id"] not in records]
-    if progress and records:
-        print(f"resuming: {len(records)} of {len(runs)} runs already in {runs_dir}", flush=True)
-
-    def on_result(run: dict, metrics: dict | None, lost: BaseException | None) -> dict:
-        if lost is not None:
-            reason = f"cluster: {type(lost).__name__}: {' '.join(str(lost).split())}"
-            metrics = {"success": False, "failure_reason": reason[:300]}
-        record = {**run, "metrics": metrics, "retry": lost is not None}
-        write_json(runs_dir / f"{run['run_id']}.json", record)
-        records[run["run_id"]] = record
-        return metrics
-
-    if todo:
-        run_on_cluster(
-            [
-                (run, f"compare-{run['run_id']}", run_one, (run["base_text"], run["overrides"]))
-                for run in todo
-            ],
-            on_result,
-            workers=workers,
-            address=address,
-            label="compare",
-            progress=progress,
-        )
+    records, _ = run_resumable(
+        runs,
+        Path(out_dir) / "runs",
+        run_id=lambda run: run["run_id"],
+        record_of=dict,
+        task=lambda run: (run_one, (run["base_text"], run["overrides"])),
+        label="compare",
+        workers=workers,
+        address=address,
+        progress=progress,
+    )
     ordered = [records[run["run_id"]] for run in runs]
-    write_outputs(ordered, out_dir)
+    write_outputs(ordered, Path(out_dir))
     return ordered
 
 

@@ -55,6 +55,51 @@ def run_one(base_text: str, overrides: list) -> dict:
     return metrics
 
 
+def run_resumable(
+    runs: list,
+    runs_dir: Path,
+    *,
+    run_id,
+    record_of,
+    task,
+    label: str,
+    workers: int,
+    address: str | None,
+    progress: bool,
+) -> tuple[dict[str, dict], int]:
+    """Simulates on the cluster the runs runs_dir does not hold yet (those the cluster
+    lost before are retried) and saves each as runs_dir/<run_id>.json as it finishes:
+    record_of(run) and its metrics. run_id(run) names a run, task(run) is (fn, args).
+    Returns run_id -> record, and how many runs this call simulated."""
+    runs_dir.mkdir(parents=True, exist_ok=True)
+    saved = [runs_dir / f"{run_id(run)}.json" for run in runs]
+    records = {path.stem: json.loads(path.read_text()) for path in saved if path.is_file()}
+    records = {key: r for key, r in records.items() if not r.get("retry")}
+    todo = [run for run in runs if run_id(run) not in records]
+    if progress and records:
+        print(f"resuming: {len(records)} of {len(runs)} runs already in {runs_dir}", flush=True)
+
+    def on_result(run, metrics: dict | None, lost: BaseException | None) -> dict:
+        if lost is not None:
+            reason = f"cluster: {type(lost).__name__}: {' '.join(str(lost).split())}"
+            metrics = {"success": False, "failure_reason": reason[:300]}
+        record = {**record_of(run), "metrics": metrics, "retry": lost is not None}
+        write_json(runs_dir / f"{run_id(run)}.json", record)
+        records[run_id(run)] = record
+        return metrics
+
+    if todo:
+        run_on_cluster(
+            [(run, f"standup-{run_id(run)}", *task(run)) for run in todo],
+            on_result,
+            workers=workers,
+            address=address,
+            label=label,
+            progress=progress,
+        )
+    return records, len(todo)
+
+
 @dataclass
 class SweepResult:
     runs: list[RunSpec]
@@ -83,40 +128,25 @@ def run_sweep(
     summary = {"name": spec.name, "base": str(spec.base_path), "seed": spec.seed}
     summary["runs"] = [{"index": r.index, "run_id": r.run_id, "params": r.params} for r in runs]
     write_json(out_dir / "sweep.json", summary)
-    # The runs saved by an earlier start, but for those the cluster lost (retried now).
-    saved = [runs_dir / f"{run.run_id}.json" for run in runs]
-    records = {path.stem: json.loads(path.read_text()) for path in saved if path.is_file()}
-    records = {run_id: r for run_id, r in records.items() if not r.get("retry")}
-    todo = [r for r in runs if r.run_id not in records]
-    if progress and records:
-        print(f"resuming: {len(records)} of {len(runs)} runs already in {runs_dir}", flush=True)
-
-    def on_result(run: RunSpec, metrics: dict | None, lost: BaseException | None) -> dict:
-        if lost is not None:
-            reason = f"cluster: {type(lost).__name__}: {' '.join(str(lost).split())}"
-            metrics = {"success": False, "failure_reason": reason[:300]}
-        record = {**asdict(run), "metrics": metrics, "retry": lost is not None}
-        write_json(runs_dir / f"{run.run_id}.json", record)
-        records[run.run_id] = record
-        return metrics
-
     t0 = time.perf_counter()
-    if todo:
-        run_on_cluster(
-            [(r, f"standup-{r.run_id}", run_one, (spec.base_text, r.overrides)) for r in todo],
-            on_result,
-            workers=workers,
-            address=address,
-            label=f"sweep {spec.name}",
-            progress=progress,
-        )
+    records, computed = run_resumable(
+        runs,
+        runs_dir,
+        run_id=lambda run: run.run_id,
+        record_of=asdict,
+        task=lambda run: (run_one, (spec.base_text, run.overrides)),
+        label=f"sweep {spec.name}",
+        workers=workers,
+        address=address,
+        progress=progress,
+    )
     wall_s = time.perf_counter() - t0
 
     ordered = [records[r.run_id] for r in runs]
     table = out_dir / "results.csv"
     write_table(table, ordered, [p.name for p in spec.grid + spec.random])
     figures = [draw_figure(fig, ordered, out_dir) for fig in spec.figures]
-    return SweepResult(runs, records, table, [f for f in figures if f], len(todo), wall_s)
+    return SweepResult(runs, records, table, [f for f in figures if f], computed, wall_s)
 
 
 # --- Command line ---------------------------------------------------------------------

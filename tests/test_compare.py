@@ -119,7 +119,7 @@ def test_against_the_reactive_partner_advancement_is_sooner_than_stiff(tmp_path,
     def no_cluster(*args, **kwargs):
         raise AssertionError("a resumed comparison simulated again")
 
-    monkeypatch.setattr("drake_standup.cluster.run_on_cluster", no_cluster)
+    monkeypatch.setattr("drake_standup.sweep.run_on_cluster", no_cluster)
     compare.run_compare(
         [compare.resolve_helper("reactive")], list(RESPONSES), tmp_path, progress=False
     )
