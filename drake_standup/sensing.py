@@ -55,30 +55,40 @@ class StandingSupport:
     cop_y_m: tuple[float, float]
 
 
-def standing_pull_usage(
+def standing_lean(
     hand_wrenches_W: np.ndarray, weight_N: float, support: StandingSupport
-) -> float:
-    """The share of what the standing robot's feet can hold that a pull needs, judged on
-    the robot standing (whatever its posture now): the hands' wrenches
-    (payloads.HAND_WRENCHES) at its standing hands give a resultant about the CoM that
-    needs the static lean d of references.static_lean at the erect height; the feet hold
-    it by leaning up to lean_m and moving the CoP to the edge of the soles' boxes (half
-    their length forward and back, half the span of both boxes sideways). 1 at the edge;
-    10 if the pull lifts the robot."""
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """What a pull asks of the standing robot's feet, judged on the robot standing
+    (whatever its posture now): the hands' wrenches (payloads.HAND_WRENCHES) at its
+    standing hands give a resultant about the CoM that needs the static lean d (3,) of
+    references.static_lean at the erect height; and how far the feet can shift the CoM
+    against it (3: forward, back, sideways), leaning up to lean_m and moving the CoP to
+    the edge of the soles' boxes (half their length forward and back, half the span of
+    both boxes sideways). None if the pull lifts the robot."""
     F = np.asarray(hand_wrenches_W).reshape(2, 6)
     wrench = np.concatenate(
         [F[:, :3].sum(axis=0) + np.cross(support.hands_m, F[:, 3:]).sum(axis=0), F[:, 3:].sum(0)]
     )
     if weight_N - wrench[5] <= 0.0:
-        return 10.0
+        return None
     d = static_lean(wrench, support.com_height_m, weight_N, math.inf)
     half_x = (support.cop_x_m[1] - support.cop_x_m[0]) / 2
     span = abs(support.soles_m[0, 1] - support.soles_m[1, 1])
     half_y = (span + support.cop_y_m[1] - support.cop_y_m[0]) / 2
     forward, back, side = support.lean_m
-    return float(
-        max(d[0] / (forward + half_x), -d[0] / (back + half_x), abs(d[1]) / (side + half_y))
-    )
+    return d, np.array([forward + half_x, back + half_x, side + half_y])
+
+
+def standing_pull_usage(
+    hand_wrenches_W: np.ndarray, weight_N: float, support: StandingSupport
+) -> float:
+    """The share of what the standing robot's feet can hold that a pull needs
+    (standing_lean): 1 at the edge; 10 if the pull lifts the robot."""
+    need = standing_lean(hand_wrenches_W, weight_N, support)
+    if need is None:
+        return 10.0
+    d, (forward, back, side) = need
+    return float(max(d[0] / forward, -d[0] / back, abs(d[1]) / side))
 
 
 class RobotSensing(LeafSystem):

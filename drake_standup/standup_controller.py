@@ -26,6 +26,7 @@ lean_W; compliance_W (the compliant response's offset and rate); mass_estimate.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
@@ -43,6 +44,7 @@ from drake_standup.control.schedule import ContactScheduler
 from drake_standup.phases import resolve_com_heights
 from drake_standup.reference import CoMReferenceGenerator
 from drake_standup.scene import erect_com_height_m
+from drake_standup.sensing import standing_lean
 from drake_standup.state_machine import StandupStateMachine
 from drake_standup.station import Station
 
@@ -133,7 +135,14 @@ def make_standup_controller(scenario: Scenario, station: Station) -> StandupCont
         "controller_model": ControllerModel(plant, robot, specs, config, period_s),
         "task_references": TaskReferenceGenerator(
             ReferenceGenerator(
-                config, schedule, as_slice(joints.q_indices), period_s, g, scenario.compliance
+                config,
+                schedule,
+                as_slice(joints.q_indices),
+                period_s,
+                g,
+                scenario.compliance,
+                partial(standing_lean, support=station.standing),
+                scenario.standup.standing_pull_usage_limit,
             ),
             period_s,
         ),

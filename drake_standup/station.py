@@ -55,6 +55,7 @@ class Station:
     scene: Scene
     pad_groups: dict[str, str]  # pad geometry name -> group, in pad_forces_W's order
     joints: ActuatedJoints
+    standing: StandingSupport  # what the standing robot's feet can hold (sensing.py)
 
     @property
     def plant(self) -> MultibodyPlant:
@@ -159,4 +160,4 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
     builder.ExportOutput(reporter.get_output_port(), "pad_forces_W")
     diagram = builder.Build()
     diagram.set_name("station")
-    return Station(diagram, scene, pad_groups, actuated_joints(plant, instance))
+    return Station(diagram, scene, pad_groups, actuated_joints(plant, instance), standing)

@@ -80,7 +80,9 @@ def other_response(request, tmp_path_factory):
 def test_stiff_and_compliant_keep_psi_equal_to_time(other_response, unassisted):
     """Under the assisted pull, stiff and compliant stand up with psi = t at every
     sample; stiff cancels the pull: its stand-up time is the unassisted one within
-    0.05 s; compliant's reference yields, within its bound, and comes back."""
+    0.05 s; compliant's reference yields, within its bound, and comes back: standing,
+    the 15 + 15 N forward pull moves it F/K forward, and the upward pull not above the
+    path (on the feet alone)."""
     scenario, m, sig = other_response
     assert m["success"], m["failure_reason"]
     assert m["response"] == scenario.response
@@ -94,10 +96,15 @@ def test_stiff_and_compliant_keep_psi_equal_to_time(other_response, unassisted):
         return
     bound = np.array(scenario.compliance.max_offset_m)
     assert (np.abs(offset) <= bound + 1e-12).all()
-    # The 15 + 15 N forward and up pull, at rest: F/K on x and z (inside the bound).
+    # The 15 + 15 N forward and up pull, standing at rest: F/K forward (inside the bound),
+    # none up.
     K = scenario.compliance.stiffness_N_per_m
     plateau = (sig["time_s"] > 7.0) & (sig["time_s"] < 10.5)  # full pull 3.5-10.5 s
-    np.testing.assert_allclose(offset[plateau][:, [0, 2]], 30.0 / K, rtol=1e-3)
+    assert (sig["state"][plateau] == 4).all()
+    np.testing.assert_allclose(offset[plateau][:, 0], 30.0 / K, rtol=1e-3)
+    np.testing.assert_allclose(offset[plateau][:, 2], 0.0, atol=1e-4)
+    seated = sig["state"] <= 2
+    assert offset[seated][:, 2].max() == pytest.approx(30.0 / K, rel=0.02)  # seated: up too
     assert np.abs(offset[-1]).max() < 1e-4  # back on the path 4 s after the pull ended
 
 

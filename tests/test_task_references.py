@@ -6,6 +6,7 @@ and the generator's memory over ticks."""
 from __future__ import annotations
 
 import math
+from functools import partial
 
 import numpy as np
 import pytest
@@ -29,6 +30,7 @@ from drake_standup.control.references import (
 from drake_standup.control.terms import RobotKinematics
 from drake_standup.phases import PHASES, PhaseTable
 from drake_standup.scene import add_scene, set_seated_state
+from drake_standup.sensing import StandingSupport, standing_lean, standing_pull_usage
 
 T = 0.004
 CONFIG = ControllerConfig()
@@ -212,14 +214,74 @@ def test_the_compliant_reference_follows_the_admittance(rig):
     assert not trace[:, 1:3].any()  # no force sideways or up: no offset there
 
 
-def test_the_compliant_offset_is_held_within_its_bound(rig):
-    """A pull far beyond the bound (100 N forward, 100 N down): each axis' offset stops at
-    compliance.max_offset_m, with no rate outward there."""
+def test_the_compliant_offset_settles_at_its_bound(rig):
+    """A pull far beyond the bound (100 N forward, 100 N down): the offset settles at
+    compliance.max_offset_m on each axis, never beyond it, and at rest there."""
     bound = np.array(Scenario().compliance.max_offset_m)
-    trace = _admittance_run(rig, np.array([100.0, 0.0, -100.0]), 500)
+    trace = _admittance_run(rig, np.array([100.0, 0.0, -100.0]), 1000)
     assert (np.abs(trace[:, :3]) <= bound + 1e-15).all()
-    np.testing.assert_allclose(trace[-1, :3], [bound[0], 0.0, -bound[2]], atol=0.0)
-    np.testing.assert_array_equal(trace[-1, 3:], np.zeros(3))
+    np.testing.assert_allclose(trace[-1, :3], [bound[0], 0.0, -bound[2]], atol=1e-7)
+    np.testing.assert_allclose(trace[-1, 3:], np.zeros(3), atol=1e-6)
+
+
+SUPPORT = StandingSupport(
+    com_height_m=0.575,
+    hands_m=np.array([[0.20, 0.12, 0.285], [0.20, -0.12, 0.285]]),
+    soles_m=np.array([[0.0, 0.07, -0.575], [0.0, -0.07, -0.575]]),
+    lean_m=(CONFIG.lean_max_forward_m, CONFIG.lean_max_back_m, CONFIG.lean_max_m),
+    cop_x_m=tuple(CONFIG.foot_cop_x_m),
+    cop_y_m=tuple(CONFIG.foot_cop_y_m),
+)
+
+
+@pytest.mark.parametrize("pull_N", [5.0, 10.0, 25.0, -8.0])
+def test_the_compliant_offset_settles_only_where_the_standing_feet_hold_the_pull(rig, pull_N):
+    """A horizontal pull_N per hand (forward; negative: back) judged on the standing
+    robot (sensing.standing_pull_usage, the stand-up's own measure): moving the CoM by x
+    toward the pull adds x to the lean the feet must give, so the offset may settle
+    where the usage reaches the limit, x = (limit - usage) reach (reach: lean plus half
+    the CoP box on that side), within the box, and at 0 where the pull alone uses more;
+    away from the pull, the box."""
+    limit = 0.6
+    joints = rig["joints"]
+    generator = ReferenceGenerator(
+        CONFIG,
+        rig["schedule"],
+        as_slice(joints.q_indices),
+        T,
+        rig["g"],
+        None,
+        partial(standing_lean, support=SUPPORT),
+        limit,
+    )
+    _, _, _, mass = _drake_com(rig)
+    weight = mass * rig["g"]
+    hands = np.tile([0.0, 0.0, 0.0, pull_N, 0.0, 0.0], 2)
+    usage = standing_pull_usage(hands, weight, SUPPORT)
+    half_x = (SUPPORT.cop_x_m[1] - SUPPORT.cop_x_m[0]) / 2
+    reach = (CONFIG.lean_max_back_m if pull_N > 0 else CONFIG.lean_max_forward_m) + half_x
+    box = np.array(Scenario().compliance.max_offset_m)
+    low, high = generator._offset_bounds(rig["schedule"][3], hands, weight)
+    toward, away = (high[0], low[0]) if pull_N > 0 else (-low[0], -high[0])
+    assert toward == pytest.approx(min(max(0.0, (limit - usage) * reach), box[0]), abs=1e-12)
+    assert away == -box[0]
+    if pull_N == 25.0:  # beyond the limit already: no yield forward
+        assert usage > limit and toward == 0.0
+    if pull_N == 10.0:  # inside the box: the bound is the feet's
+        assert 0.0 < toward < box[0]
+
+
+def test_on_the_feet_alone_the_compliant_offset_settles_no_higher_than_the_path(rig):
+    """An upward pull: seated (states 1-2) the offset may settle up to the box; on the
+    feet alone (states 3-4, the states that lean) at most at the path's height; down,
+    the box in every state."""
+    generator = rig["generator"]
+    box = np.array(Scenario().compliance.max_offset_m)
+    pull = np.tile([0.0, 0.0, 0.0, 0.0, 0.0, 10.0], 2)
+    for state in (1, 2, 3, 4):
+        low, high = generator._offset_bounds(rig["schedule"][state], pull, 300.0)
+        assert high[2] == (0.0 if TABLE.phase(state).lean else box[2])
+        assert low[2] == -box[2]
 
 
 def test_the_compliant_offset_returns_once_the_pull_stops(rig):

@@ -36,7 +36,9 @@ acts: advancement lets f_par through (above); stiff and compliant compensate the
     M xddot + D xdot + K x = f_h,   each axis of x within compliance.max_offset_m,
 
 integrated each tick (semi-implicit Euler), its rate and acceleration added to the
-reference's; it returns to zero when the pull, or the compliant response, stops.
+reference's; it returns to zero when the pull, or the compliant response, stops. On the
+horizontally it settles only as far as the standing feet could still hold the pull, and
+on the feet alone not above the path (ReferenceGenerator._offset_bounds).
 
 The posture reference and the base's target orientation:
 
@@ -45,6 +47,7 @@ The posture reference and the base's target orientation:
 """
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -222,13 +225,19 @@ class ReferenceGenerator:
         period_s: float,
         gravity_mps2: float = 0.0,
         compliance: ComplianceConfig | None = None,
+        standing_need: Callable | None = None,
+        usage_limit: float = 1.0,
     ):
         """q_joints: the actuated joints' entries of q, in the schedule's order;
         gravity_mps2: g, the plant's. The robot's weight is that of the model the terms
         are computed with (terms.mass_kg g: the controller's estimate once it has
         weighed the robot), for the lean against the pull and the height integral's
         bound. compliance: the admittance of the compliant response (default: its
-        defaults)."""
+        defaults); standing_need(F_hand_W, weight_N): what the pull asks of the standing
+        feet, (d, reach) or None (sensing.standing_lean), and usage_limit the share of
+        their reach the compliant offset may use (None: the box alone)."""
+        self._standing_need = standing_need
+        self._usage_limit = usage_limit
         compliance = compliance or ComplianceConfig()
         mass, stiffness = compliance.virtual_mass_kg, compliance.stiffness_N_per_m
         self._admittance = (
@@ -281,18 +290,52 @@ class ReferenceGenerator:
             return lean
         return lean + self._lean_blend * (target - lean)
 
-    def _yield(self, f_hand_W: np.ndarray | None, compliance: np.ndarray) -> np.ndarray:
+    def _offset_bounds(
+        self, state: StateReferences, F_hand_W: np.ndarray, weight_N: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(low, high) of where the compliant offset may settle this tick (its anchor,
+        _yield): within compliance.max_offset_m; horizontally, only as far as the
+        standing feet could hold the pull with the CoM moved by x: the lean the pull then
+        needs, d - x (standing_need: d and the feet's reach, judged on the robot standing
+        whatever its posture now, as the stand-up's wait is), within standup.
+        standing_pull_usage_limit of their reach, or x settles at 0 on that side; and, on
+        the feet alone (the states that lean), not above the path: the legs carry the rise
+        on the path's own timing (an upward yield ran the CoM 1.2 cm past the erect height
+        at the rise's end, at a 1 ms step; measured)."""
+        box = self._admittance[3]
+        low, high = -box.copy(), box.copy()
+        need = None if self._standing_need is None else self._standing_need(F_hand_W, weight_N)
+        if need is not None:
+            d, (forward, back, side) = need
+            limit = self._usage_limit
+            high[:2] = np.minimum(high[:2], np.maximum(0.0, d[:2] + limit * np.array([back, side])))
+            low[:2] = np.maximum(
+                low[:2], np.minimum(0.0, d[:2] - limit * np.array([forward, side]))
+            )
+        if state.lean:
+            high[2] = 0.0
+        return low, high
+
+    def _yield(
+        self,
+        f_hand_W: np.ndarray | None,
+        compliance: np.ndarray,
+        bounds: tuple[np.ndarray, np.ndarray],
+    ) -> np.ndarray:
         """The admittance's next [offset, rate] (6,) from this tick's [offset, rate] under
-        the hands' total force f_hand_W (N; None: no pull, or not compliant): semi-implicit
-        Euler, the offset held within its bound with no rate outward there."""
-        mass, damping, stiffness, bound = self._admittance
+        the hands' total force f_hand_W (N; None: no pull, or not compliant), by
+        semi-implicit Euler. The bounds (low, high) bound the spring's anchor, f / K,
+        where the pull alone would hold the offset: so the offset follows a bound that
+        moves (the lean's support, the rise's top) as smoothly as a pull, critically
+        damped, instead of jumping to it; compliance.max_offset_m holds it in any case,
+        with no rate outward there."""
+        mass, damping, stiffness, box = self._admittance
         x, v = compliance[:3], compliance[3:]
-        force = -damping * v - stiffness * x
-        if f_hand_W is not None:
-            force += f_hand_W
+        anchor = np.zeros(3) if f_hand_W is None else np.clip(f_hand_W / stiffness, *bounds)
+        force = -damping * v - stiffness * (x - anchor)
         v_next = v + (self._period_s / mass) * force
         x_next = x + self._period_s * v_next
-        held = np.clip(x_next, -bound, bound)
+        held = np.clip(x_next, -box, box)
         outward = (held != x_next) & (v_next * x_next > 0.0)
         v_next[outward] = 0.0
         return np.concatenate((held, v_next))
@@ -336,7 +379,11 @@ class ReferenceGenerator:
         next_compliance = compliance
         if pulled or compliance.any():
             next_compliance = self._yield(
-                F_hand_W[3:6] + F_hand_W[9:12] if pulled else None, compliance
+                F_hand_W[3:6] + F_hand_W[9:12] if pulled else None,
+                compliance,
+                self._offset_bounds(state, F_hand_W, terms.mass_kg * self._gravity_mps2)
+                if pulled
+                else (np.zeros(3), np.zeros(3)),
             )
             com_reference = com_reference + np.concatenate(
                 (
