@@ -214,7 +214,7 @@ def markdown(records: list[dict]) -> str:
             stood = "yes" if m.get("success") else f"no: {m.get('failure_reason')}"
             lines.append(
                 f"| {helper} | {response} | {stood} | {cell(m.get('standup_time_s'), '.2f')} | "
-                f"{'' if sooner is None else f'{100 * sooner:+.0f} %'} | "
+                f"{'' if sooner is None else f'{round(100 * sooner):+d} %'} | "
                 f"{cell(m.get('held_back_s'), '.1f')} | "
                 f"{cell(m.get('helper_work_J'), '.1f')} | "
                 f"{cell(m.get('helper_positive_work_J'), '.1f')} | "
@@ -291,7 +291,7 @@ def summary(records: list[dict]) -> list[str]:
         if "advancement" in responses:
             sooner = sooner_than_stiff(responses["advancement"], responses.get("stiff"))
             if sooner is not None:
-                line += f"; advancement {100 * sooner:.0f} % sooner than stiff"
+                line += f"; advancement {round(100 * sooner)} % sooner than stiff"
         lines.append(line)
     return lines
 

@@ -217,7 +217,9 @@ class ComplianceConfig:
         M a + D v + K x = f_hands,   D = 2 zeta sqrt(K M),
 
     x the reference's offset (W), f_hands the measured pull of both hands. Bounded so the
-    robot stays over its support: each axis within max_offset_m."""
+    robot stays over its support: each axis within max_offset_m; horizontally only as far
+    as the standing feet could still hold the pull (standup.standing_pull_usage_limit);
+    on the feet alone not above the path (control/references.py)."""
 
     # The robot's own mass (iCubGazeboV2_5: 33 kg): the reference yields to the pull as
     # the robot itself would, free, at first (Omega f = f / m, SPEC 2). kg.
