@@ -139,7 +139,12 @@ def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> 
         print(f"set {path} = {value}")
     if m.get("standup_time_s") is not None:
         outcome = f"stood up in {m['standup_time_s']:.2f} s"
-        if m.get("standup_time_s_without_advancement") is not None:
+        response = m.get("response", "advancement")
+        if response in ("stiff", "compliant"):
+            outcome += f" (response {response}: psi = t)"
+        elif "+" in response:  # the live page's switch moved
+            outcome += f" (responses {response})"
+        elif m.get("standup_time_s_without_advancement") is not None:
             outcome += f" ({m['standup_time_s_without_advancement']:.2f} s without advancement)"
         elif "standup_time_s_without_advancement" in m:
             outcome += " (did not stand up without advancement)"

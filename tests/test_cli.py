@@ -185,3 +185,42 @@ def test_python_m_drake_standup_is_the_same_command(capsys):
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout == _cli(capsys, ["scenarios"])[1]
+
+
+@pytest.mark.parametrize(
+    ("response", "said"),
+    [
+        ("advancement", "stood up in 2.38 s (3.42 s without advancement)"),
+        ("stiff", "stood up in 3.52 s (response stiff: psi = t)"),
+        ("advancement+stiff", "stood up in 2.38 s (responses advancement+stiff)"),
+    ],
+)
+def test_the_summary_line_names_a_response_that_holds_psi_to_time(
+    monkeypatch, capsys, tmp_path, response, said
+):
+    """The run's last line: with advancement, the psi = t run's time beside it; with
+    stiff or compliant (psi = t, no such run) the response; with the live switch moved,
+    the responses used."""
+    import types
+
+    import drake_standup.simulate
+
+    t = 3.52 if response == "stiff" else 2.38
+    metrics = {
+        "success": True,
+        "failure_reason": None,
+        "standup_time_s": t,
+        "standup_time_s_without_advancement": 3.42 if response == "advancement" else t,
+        "psi_final": 15.0,
+        "sim_time_s": 15.0,
+        "wall_time_s": 10.0,
+        "realtime_factor": 1.5,
+        "response": response,
+    }
+    fake = types.SimpleNamespace(metrics=metrics, files={})
+    monkeypatch.setattr(drake_standup.simulate, "simulate", lambda *a, **k: fake)
+    assert main(["run", "--no-recording", "--out", str(tmp_path / "o")]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert (
+        last == f"OK: {said}; psi_final 15.00; simulated 15.00 s in 10.0 s wall (1.50x real time)"
+    )
