@@ -18,13 +18,13 @@ OUT/comparison.png (the same four quantities per helper and response).
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from drake_standup.arguments import OneLineErrorParser, positive_int
+from drake_standup.sweep_table import finite_number
 
 # The scripted pull, the reactive partner, the lateral and the hindering pull, and four
 # random helpers of the helpers campaign (issue 23).
@@ -45,10 +45,6 @@ SHOWN = (
     ("helper_peak_force_N", "peak hand force", "N", 1.0),
     ("path_deviation_max_m", "path deviation", "cm", 100.0),
 )
-COLUMNS = (
-    "success failure_reason standup_time_s helper_work_J helper_positive_work_J "
-    "helper_peak_force_N helper_impulse_Ns path_deviation_max_m psi_final"
-).split()
 EXAMPLE = "example: drake-standup compare --helpers reactive assisted --out out/compare"
 
 
@@ -181,17 +177,15 @@ def _by_helper(records: list[dict]) -> dict[str, dict[str, dict]]:
     return table
 
 
-def _number(value) -> float | None:
-    ok = isinstance(value, int | float) and not isinstance(value, bool)
-    return float(value) if ok and math.isfinite(value) else None
-
-
 def sooner_than_stiff(metrics: dict, stiff: dict | None) -> float | None:
     """How much sooner than stiff the run stood up, a fraction of stiff's time (None
     where either did not stand up)."""
     if stiff is None or not (metrics.get("success") and stiff.get("success")):
         return None
-    mine, theirs = _number(metrics.get("standup_time_s")), _number(stiff.get("standup_time_s"))
+    mine, theirs = (
+        finite_number(metrics.get("standup_time_s")),
+        finite_number(stiff.get("standup_time_s")),
+    )
     return None if mine is None or not theirs else 1.0 - mine / theirs
 
 
@@ -205,7 +199,7 @@ def markdown(records: list[dict]) -> str:
     lines = [head, "|" + "---|" * 11]
 
     def cell(value, fmt: str, scale: float = 1.0) -> str:
-        number = _number(value)
+        number = finite_number(value)
         return "" if number is None else format(scale * number, fmt)
 
     for helper, responses in _by_helper(records).items():
@@ -247,7 +241,7 @@ def draw(records: list[dict], path: Path) -> None:
             values, failed = [], []
             for i, helper in enumerate(helpers):
                 m = table[helper].get(response, {})
-                value = _number(m.get(metric))
+                value = finite_number(m.get(metric))
                 values.append(np.nan if value is None else scale * value)
                 if not m.get("success"):
                     failed.append(at[i])
@@ -281,8 +275,8 @@ def summary(records: list[dict]) -> list[str]:
     for helper, responses in _by_helper(records).items():
         parts = []
         for response, m in responses.items():
-            t = _number(m.get("standup_time_s"))
-            work = _number(m.get("helper_work_J"))
+            t = finite_number(m.get("standup_time_s"))
+            work = finite_number(m.get("helper_work_J"))
             text = f"{response} " + ("did not stand up" if not m.get("success") else f"{t:.2f} s")
             if work is not None:
                 text += f" ({work:.1f} J)"

@@ -4,23 +4,17 @@ per bin of a parameter)."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 
 from drake_standup.sweep_file import Figure
-from drake_standup.sweep_table import table_rows
+from drake_standup.sweep_table import finite_number, table_rows
 
 
 def _order(value):
     """Sorts numbers numerically and before anything else."""
     return (0, value, "") if isinstance(value, (int, float)) else (1, 0, str(value))
-
-
-def _number(value) -> float | None:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-    return float(value) if ok and math.isfinite(value) else None
 
 
 def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
@@ -42,14 +36,16 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
         for k, g in enumerate(groups):
             sel = [r for r in rows if fig.group is None or r.get(fig.group) == g]
             xs = sorted({r[fig.x] for r in sel}, key=_order)
-            stood = [(r[fig.x], _number(r.get(fig.y))) for r in sel if r.get("success")]
+            stood = [(r[fig.x], finite_number(r.get(fig.y))) for r in sel if r.get("success")]
             mean = [
                 np.mean([y for x, y in stood if x == at and y is not None] or [np.nan]) for at in xs
             ]
             label = f"{fig.group} = {g}" if fig.group else None
             (line,) = ax.plot(xs, mean, marker=markers[k % len(markers)], label=label)
             # Failed runs: a cross at their value, or on the x axis without one.
-            failed = [(r[fig.x], _number(r.get(fig.y)) or 0.0) for r in sel if not r.get("success")]
+            failed = [
+                (r[fig.x], finite_number(r.get(fig.y)) or 0.0) for r in sel if not r.get("success")
+            ]
             if failed:
                 ax.plot(*zip(*failed), "x", color=line.get_color(), ms=10, mew=2)
         if fig.group:

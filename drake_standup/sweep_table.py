@@ -57,6 +57,13 @@ def write_table(path: Path, records: list[dict], param_names: list[str]) -> None
             writer.writerow({c: _cell(row.get(c)) for c in columns})
 
 
+def finite_number(value) -> float | None:
+    """value as a float if it is a finite number (not a boolean), else None: a metric
+    a table or figure can show."""
+    ok = isinstance(value, int | float) and not isinstance(value, bool)
+    return float(value) if ok and math.isfinite(value) else None
+
+
 def _cell(value):
     """None and non-finite numbers as empty cells."""
     finite = not isinstance(value, float) or math.isfinite(value)

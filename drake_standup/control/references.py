@@ -36,8 +36,8 @@ acts: advancement lets f_par through (above); stiff and compliant compensate the
     M xddot + D xdot + K x = f_h,   each axis of x within compliance.max_offset_m,
 
 integrated each tick (semi-implicit Euler), its rate and acceleration added to the
-reference's; it returns to zero when the pull, or the compliant response, stops. On the
-horizontally it settles only as far as the standing feet could still hold the pull, and
+reference's; it returns to zero when the pull, or the compliant response, stops.
+Horizontally it settles only as far as the standing feet could still hold the pull, and
 on the feet alone not above the path (ReferenceGenerator._offset_bounds).
 
 The posture reference and the base's target orientation:
@@ -293,7 +293,7 @@ class ReferenceGenerator:
     def _offset_bounds(
         self, state: StateReferences, F_hand_W: np.ndarray, weight_N: float
     ) -> tuple[np.ndarray, np.ndarray]:
-        """(low, high) of where the compliant offset may settle this tick (its anchor,
+        """(low, high) of where the compliant offset may settle this tick (the anchor of
         _yield): within compliance.max_offset_m; horizontally, only as far as the
         standing feet could hold the pull with the CoM moved by x: the lean the pull then
         needs, d - x (standing_need: d and the feet's reach, judged on the robot standing
@@ -316,22 +316,15 @@ class ReferenceGenerator:
             high[2] = 0.0
         return low, high
 
-    def _yield(
-        self,
-        f_hand_W: np.ndarray | None,
-        compliance: np.ndarray,
-        bounds: tuple[np.ndarray, np.ndarray],
-    ) -> np.ndarray:
-        """The admittance's next [offset, rate] (6,) from this tick's [offset, rate] under
-        the hands' total force f_hand_W (N; None: no pull, or not compliant), by
-        semi-implicit Euler. The bounds (low, high) bound the spring's anchor, f / K,
-        where the pull alone would hold the offset: so the offset follows a bound that
-        moves (the lean's support, the rise's top) as smoothly as a pull, critically
-        damped, instead of jumping to it; compliance.max_offset_m holds it in any case,
-        with no rate outward there."""
+    def _yield(self, anchor: np.ndarray, compliance: np.ndarray) -> np.ndarray:
+        """The admittance's next [offset, rate] (6,) from this tick's [offset, rate], by
+        semi-implicit Euler, pulled toward anchor (3: where the pull alone would hold the
+        offset, f / K within _offset_bounds; 0 with no pull): so the offset follows a
+        bound that moves as smoothly as it follows a pull, critically damped, instead of
+        jumping to it. compliance.max_offset_m holds it in any case, with no rate outward
+        there."""
         mass, damping, stiffness, box = self._admittance
         x, v = compliance[:3], compliance[3:]
-        anchor = np.zeros(3) if f_hand_W is None else np.clip(f_hand_W / stiffness, *bounds)
         force = -damping * v - stiffness * (x - anchor)
         v_next = v + (self._period_s / mass) * force
         x_next = x + self._period_s * v_next
@@ -378,13 +371,11 @@ class ReferenceGenerator:
         pulled = F_hand_W is not None and response == COMPLIANT
         next_compliance = compliance
         if pulled or compliance.any():
-            next_compliance = self._yield(
-                F_hand_W[3:6] + F_hand_W[9:12] if pulled else None,
-                compliance,
-                self._offset_bounds(state, F_hand_W, terms.mass_kg * self._gravity_mps2)
-                if pulled
-                else (np.zeros(3), np.zeros(3)),
-            )
+            anchor = np.zeros(3)
+            if pulled:
+                bounds = self._offset_bounds(state, F_hand_W, terms.mass_kg * self._gravity_mps2)
+                anchor = np.clip((F_hand_W[3:6] + F_hand_W[9:12]) / self._admittance[2], *bounds)
+            next_compliance = self._yield(anchor, compliance)
             com_reference = com_reference + np.concatenate(
                 (
                     next_compliance,
