@@ -1,6 +1,6 @@
 """What pyproject.toml cannot say: the wheel's packages are found (every subpackage of
 drake_standup), and the top-level folders models/, scenarios/ and sweeps/ ship inside the
-package as drake_standup/data/<folder> (read by drake_standup/resources.py).
+package as drake_standup/data/<folder> (read by drake_standup/config/resources.py).
 Everything else is in pyproject.toml."""
 
 from setuptools import find_packages, setup

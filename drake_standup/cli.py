@@ -14,16 +14,25 @@ import importlib
 import sys
 from pathlib import Path
 
-from drake_standup.arguments import OneLineErrorParser, parse_set
+from drake_standup.config.arguments import OneLineErrorParser, parse_set
 
 # Command -> (module with main(argv, prog), one line of help).
 COMMANDS = {
     "run": ("drake_standup.cli", "simulate one scenario: recording, metrics, figures"),
     "live": ("drake_standup.cli", "be the helper: run paced at real time, pull from the page"),
-    "sweep": ("drake_standup.sweep", "many runs on Dask: a grid, random draws, perturbations"),
-    "compare": ("drake_standup.compare", "advancement, stiff and compliant on the same helpers"),
-    "bench": ("drake_standup.bench", "how fast the stand-up simulates, and where time goes"),
-    "convergence": ("drake_standup.convergence", "the plant-step convergence study"),
+    "sweep": (
+        "drake_standup.studies.sweep",
+        "many runs on Dask: a grid, random draws, perturbations",
+    ),
+    "compare": (
+        "drake_standup.studies.compare",
+        "advancement, stiff and compliant on the same helpers",
+    ),
+    "bench": (
+        "drake_standup.studies.bench",
+        "how fast the stand-up simulates, and where time goes",
+    ),
+    "convergence": ("drake_standup.studies.convergence", "the plant-step convergence study"),
     "scenarios": ("drake_standup.cli", "list the shipped scenarios and sweeps"),
 }
 
@@ -101,7 +110,7 @@ def run_parser(prog: str) -> OneLineErrorParser:
         "--live",
         action="store_true",
         help="be the helper: paced at real time, pull the hands from the Meshcat page "
-        "(drake_standup/live.py); without --duration until Stop or Ctrl-C (at most 300 s)",
+        "(drake_standup/sim/live.py); without --duration until Stop or Ctrl-C (at most 300 s)",
     )
     return parser
 
@@ -124,10 +133,10 @@ def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> 
         print(f"error: {err}", file=sys.stderr)
         return 2
 
-    from drake_standup.simulate import simulate
+    from drake_standup.sim.simulate import simulate
 
     if args.live:
-        from drake_standup.live import run_live
+        from drake_standup.sim.live import run_live
 
         result = run_live(scenario, args.out, args.duration)
     else:
@@ -170,7 +179,7 @@ def scenarios_main(argv: list[str] | None = None, prog: str = "drake-standup sce
         epilog="example:\n  drake-standup scenarios\n  drake-standup run --scenario seated",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     ).parse_args(argv)
-    from drake_standup.resources import data_root, description, shipped
+    from drake_standup.config.resources import data_root, description, shipped
 
     for folder, command in (("scenarios", "run --scenario"), ("sweeps", "sweep")):
         print(f"{folder} ({data_root() / folder}; drake-standup {command} NAME):")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
-from drake_standup.simulate import simulate
+from drake_standup.sim.simulate import simulate
 
 
 @pytest.fixture(scope="session")
@@ -30,7 +30,7 @@ def limp_robot_rig():
     from pydrake.systems.framework import DiagramBuilder
     from pydrake.systems.primitives import ConstantVectorSource
 
-    from drake_standup.robot import ContactModel, add_icub
+    from drake_standup.robot.icub import ContactModel, add_icub
 
     def build(make_human, dt: float = 1e-3):
         builder = DiagramBuilder()

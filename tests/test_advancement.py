@@ -11,11 +11,11 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.analysis import Simulator
 
-from drake_standup.advancement import TrajectoryAdvancement, lead, psi_dot_law
 from drake_standup.config import RESPONSES, AdvancementConfig
-from drake_standup.phases import PhaseTable
-from drake_standup.robot import ContactModel, add_icub
-from drake_standup.sensing import RobotSensing
+from drake_standup.config.phases import PhaseTable
+from drake_standup.robot.icub import ContactModel, add_icub
+from drake_standup.standup.advancement import TrajectoryAdvancement, lead, psi_dot_law
+from drake_standup.world.sensing import RobotSensing
 
 # The paper's on/off law (alpha_full <= alpha_min): the laws' values below are the
 # paper's and the authors' formulas; the graded gates have tests of their own.

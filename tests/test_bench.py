@@ -12,9 +12,9 @@ import statistics
 
 import pytest
 
-from drake_standup import bench
 from drake_standup.config import Scenario
 from drake_standup.control.controller import TIMING
+from drake_standup.studies import bench
 
 DURATION_S = 0.05
 REPEAT = 2

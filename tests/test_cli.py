@@ -203,7 +203,7 @@ def test_the_summary_line_names_a_response_that_holds_psi_to_time(
     the responses used."""
     import types
 
-    import drake_standup.simulate
+    import drake_standup.sim.simulate
 
     t = 3.52 if response == "stiff" else 2.38
     metrics = {
@@ -218,7 +218,7 @@ def test_the_summary_line_names_a_response_that_holds_psi_to_time(
         "response": response,
     }
     fake = types.SimpleNamespace(metrics=metrics, files={})
-    monkeypatch.setattr(drake_standup.simulate, "simulate", lambda *a, **k: fake)
+    monkeypatch.setattr(drake_standup.sim.simulate, "simulate", lambda *a, **k: fake)
     assert main(["run", "--no-recording", "--out", str(tmp_path / "o")]) == 0
     last = capsys.readouterr().out.strip().splitlines()[-1]
     assert (

@@ -10,10 +10,10 @@ import json
 import numpy as np
 import pytest
 
-from drake_standup import compare
 from drake_standup.config import RESPONSES, load_scenario, parse_scenario
-from drake_standup.sweep_file import expand, load_sweep
-from drake_standup.sweep_table import read_table
+from drake_standup.studies import compare
+from drake_standup.studies.sweep_file import expand, load_sweep
+from drake_standup.studies.sweep_table import read_table
 
 
 def test_a_campaign_helper_is_that_runs_overrides_and_each_response_is_one_more():
@@ -119,7 +119,7 @@ def test_against_the_reactive_partner_advancement_is_sooner_than_stiff(tmp_path,
     def no_cluster(*args, **kwargs):
         raise AssertionError("a resumed comparison simulated again")
 
-    monkeypatch.setattr("drake_standup.sweep.run_on_cluster", no_cluster)
+    monkeypatch.setattr("drake_standup.studies.sweep.run_on_cluster", no_cluster)
     compare.run_compare(
         [compare.resolve_helper("reactive")], list(RESPONSES), tmp_path, progress=False
     )

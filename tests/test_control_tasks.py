@@ -14,9 +14,9 @@ from pydrake.systems.framework import DiagramBuilder
 from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
 from drake_standup.control.model import contact_specs
 from drake_standup.control.qp import ContactCommands, ContactMap, QpLayout, Task, WholeBodyQp
-from drake_standup.control.references import TaskReferences, static_lean
 from drake_standup.control.terms import RobotKinematics, RobotTerms
-from drake_standup.scene import add_scene, set_seated_state
+from drake_standup.standup.task_references import TaskReferences, static_lean
+from drake_standup.world.scene import add_scene, set_seated_state
 
 TARGET_RAD_PER_S2 = 2.0
 

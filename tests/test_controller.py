@@ -20,20 +20,20 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
+from drake_standup.config.phases import PhaseTable
 from drake_standup.control.controller import DIAGNOSTICS, WholeBodyController
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
-from drake_standup.control.references import (
+from drake_standup.control.terms import RobotKinematics
+from drake_standup.standup.contact_schedule import CONTACTS, contact_commands, phase_seat_hold
+from drake_standup.standup.state_machine import initial_mode
+from drake_standup.standup.task_references import (
     ReferenceGenerator,
     StandupSchedule,
     TaskReferenceGenerator,
     helpful_force,
 )
-from drake_standup.control.schedule import CONTACTS, contact_commands, phase_seat_hold
-from drake_standup.control.terms import RobotKinematics
-from drake_standup.phases import PhaseTable
-from drake_standup.scene import add_scene, set_seated_state
-from drake_standup.state_machine import initial_mode
+from drake_standup.world.scene import add_scene, set_seated_state
 
 G = 9.81
 N_SAMPLES = 12
@@ -257,7 +257,7 @@ def test_cop_boxes_lie_on_their_pads(scene):
     seated pose)."""
     import yaml
 
-    from drake_standup.robot import CONTACT_FILE
+    from drake_standup.robot.icub import CONTACT_FILE
 
     scene, x0 = scene
     plant, robot = scene.plant, scene.robot

@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-import drake_standup.convergence.cli as convergence_cli
-from drake_standup.convergence import (
+import drake_standup.studies.convergence.cli as convergence_cli
+from drake_standup.studies.convergence import (
     BOUNDS,
     COM_DEVIATION_M,
     Case,

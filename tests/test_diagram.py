@@ -7,7 +7,7 @@ import pytest
 from pydrake.systems.framework import Diagram, InputPortIndex
 
 from drake_standup.config import load_scenario
-from drake_standup.diagram import build_diagram
+from drake_standup.sim.diagram import build_diagram
 
 STATION = ("plant", "scene_graph", "contact_forces", "sensing", "hand_wrench_sensor")
 CONTROLLER = (
@@ -71,7 +71,7 @@ def test_signals_flow_from_the_human_through_the_station_to_the_controller(built
 
 
 def test_dot_shows_every_system_in_its_box(built, tmp_path):
-    from drake_standup.recording import export_diagram
+    from drake_standup.outputs.recording import export_diagram
 
     dot = export_diagram(built.diagram, tmp_path)[0].read_text()
     for name in ("station", "standup_controller", "human", *STATION, *CONTROLLER):

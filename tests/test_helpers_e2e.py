@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from drake_standup.config import SCENARIO_DIR, Pull, load_scenario
-from drake_standup.runner import prepare
-from drake_standup.simulate import simulate
+from drake_standup.sim.runner import prepare
+from drake_standup.sim.simulate import simulate
 
 pytestmark = pytest.mark.slow
 

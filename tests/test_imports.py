@@ -113,11 +113,11 @@ def test_the_check_sees_every_kind_of_import(tmp_path, monkeypatch):
 @pytest.mark.parametrize(
     "low, high",
     [
-        ("drake_standup.config", "drake_standup.diagram"),
-        ("drake_standup.phases", "drake_standup.state_machine"),
-        ("drake_standup.control.controller", "drake_standup.runner"),
-        ("drake_standup.runner", "drake_standup.live"),
-        ("drake_standup.arguments", "drake_standup.cli"),
+        ("drake_standup.config", "drake_standup.sim.diagram"),
+        ("drake_standup.config.phases", "drake_standup.standup.state_machine"),
+        ("drake_standup.control.controller", "drake_standup.sim.runner"),
+        ("drake_standup.sim.runner", "drake_standup.sim.live"),
+        ("drake_standup.config.arguments", "drake_standup.cli"),
     ],
 )
 def test_layers_import_downward_only(low, high):

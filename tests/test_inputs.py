@@ -36,8 +36,8 @@ from drake_standup.config import (
     validate,
 )
 from drake_standup.config.inputs import check_chair_file, model_names, scene_frames
-from drake_standup.perturbations import robot_body_names
-from drake_standup.robot import ContactModel, Robot, add_icub
+from drake_standup.robot.icub import ContactModel, Robot, add_icub
+from drake_standup.world.perturbations import robot_body_names
 
 REPO = Path(__file__).resolve().parent.parent
 SHIPPED_CHAIR = REPO / "models" / "chair.sdf"

@@ -14,9 +14,8 @@ import numpy as np
 import pytest
 
 from drake_standup.config import SCENARIO_DIR, HumanConfig, Push, Scenario, load_scenario
-from drake_standup.diagram import build_diagram
-from drake_standup.human import HumanWrenchSource
-from drake_standup.live import (
+from drake_standup.sim.diagram import build_diagram
+from drake_standup.sim.live import (
     RESET,
     RESPONSE,
     SLIDERS,
@@ -29,7 +28,8 @@ from drake_standup.live import (
     make_live_meshcat,
     run_session,
 )
-from drake_standup.runner import advance, prepare
+from drake_standup.sim.runner import advance, prepare
+from drake_standup.world.human import HumanWrenchSource
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -430,7 +430,7 @@ def test_pacing_reports_the_achieved_rate_once_a_second_and_never_catches_up(mon
     """A machine at half real time: one line a second with the rate over that second
     (0.50x), and the pacing restarted whenever the simulation lags the wall clock by
     more than MAX_LAG_S; at real time, nothing is said."""
-    from drake_standup import live
+    from drake_standup.sim import live
 
     wall = [100.0]
     monkeypatch.setattr(live.time, "perf_counter", lambda: wall[0])
@@ -453,7 +453,7 @@ def test_pacing_reports_the_achieved_rate_once_a_second_and_never_catches_up(mon
 
 
 def test_live_bench_refuses_a_bad_scenario_with_one_line(capsys):
-    from drake_standup.live_bench import main
+    from drake_standup.studies.live_bench import main
 
     assert main(["--scenario", "nosuch"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
@@ -464,7 +464,7 @@ def test_live_bench_helper_sets_both_hands_sliders_between_chunks():
     """The scripted helper of the live benchmark pulls through the page's sliders (the
     switch on, the left hand's pair), once its wall-time delay has passed: the plant then
     applies the pull at both hands."""
-    from drake_standup.live_bench import ScriptedHelper
+    from drake_standup.studies.live_bench import ScriptedHelper
 
     scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
     meshcat = make_live_meshcat()

@@ -13,8 +13,8 @@ from pydrake.systems.framework import DiagramBuilder
 from drake_standup.config import ControllerConfig, Scenario
 from drake_standup.control.mass import RESCALE_ABOVE, mass_estimate, next_mass_state
 from drake_standup.control.model import ControllerModel, contact_specs
-from drake_standup.control.schedule import contact_commands
-from drake_standup.scene import add_scene, set_seated_state
+from drake_standup.standup.contact_schedule import contact_commands
+from drake_standup.world.scene import add_scene, set_seated_state
 
 BOUNDS = (0.7, 1.3)
 

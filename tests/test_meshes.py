@@ -1,4 +1,4 @@
-"""STL reading, OBJ conversion and decimation (drake_standup.meshes).
+"""STL reading, OBJ conversion and decimation (drake_standup.robot.meshes).
 
 References are meshes written here by hand: a tetrahedron as binary and as
 ASCII STL, and a subdivided icosphere, so every expected count, coordinate
@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from pydrake.geometry import Mesh, ReadObjToTriangleSurfaceMesh
 
-from drake_standup import meshes
+from drake_standup.robot import meshes
 
 # A tetrahedron, coordinates in mm (exact in float32), faces wound outwards.
 TET_VERTICES = np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [0.0, 20.0, 0.0], [0.0, 0.0, 30.0]])

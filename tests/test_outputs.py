@@ -8,7 +8,7 @@ import re
 import pytest
 
 from drake_standup.config import load_scenario
-from drake_standup.diagram import build_diagram
+from drake_standup.sim.diagram import build_diagram
 
 
 def _meshcat_commands(html: str) -> list[bytes]:
@@ -38,7 +38,7 @@ def test_html_is_self_contained_and_holds_the_recording(seated_run):
 def test_dot_names_every_system(tmp_path):
     """The exported DOT (two levels deep) names every system of the diagram and of its
     two boxes, the station and the stand-up controller."""
-    from drake_standup.recording import export_diagram
+    from drake_standup.outputs.recording import export_diagram
 
     built = build_diagram(load_scenario())
     dot = export_diagram(built.diagram, tmp_path)[0].read_text()

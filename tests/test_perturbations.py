@@ -24,20 +24,20 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource, PassThrough
 
-from drake_standup import perturbations
 from drake_standup.config import HumanConfig, InitialPose, Pull, Push, Scenario, ScenarioError
-from drake_standup.diagram import build_diagram
-from drake_standup.human import HumanWrenchSource
-from drake_standup.perturbations import (
+from drake_standup.config.resources import model_file
+from drake_standup.robot.icub import ContactModel, add_icub
+from drake_standup.sim.diagram import build_diagram
+from drake_standup.sim.simulate import simulate
+from drake_standup.world import perturbations
+from drake_standup.world.human import HumanWrenchSource
+from drake_standup.world.perturbations import (
     NoisyWrenchSensor,
     PushSource,
     apply_model_errors,
     scale_friction,
 )
-from drake_standup.resources import model_file
-from drake_standup.robot import ContactModel, add_icub
-from drake_standup.scene import set_seated_state
-from drake_standup.simulate import simulate
+from drake_standup.world.scene import set_seated_state
 
 PUSHES = [
     Push(body="chest", start_s=0.5, duration_s=0.2, force_N=[30.0, -5.0, 2.0]),

@@ -9,7 +9,7 @@ import yaml
 
 from drake_standup.config import Scenario, ScenarioError, apply_overrides, parse_scenario
 from drake_standup.config.legacy import LEGACY
-from drake_standup.phases import PHASES, PhaseTable, posture
+from drake_standup.config.phases import PHASES, PhaseTable, posture
 
 # SPEC 3's posture rows (state 2 with the probe's torso pitch 1.0, SPEC 7).
 SPEC_POSTURES = {
@@ -187,8 +187,8 @@ def test_each_robot_rises_to_its_own_erect_height(model, height_m):
     stays as it is."""
     from pydrake.systems.framework import DiagramBuilder
 
-    from drake_standup.phases import resolve_com_heights
-    from drake_standup.scene import add_scene, erect_com_height_m
+    from drake_standup.config.phases import resolve_com_heights
+    from drake_standup.world.scene import add_scene, erect_com_height_m
 
     scenario = apply_overrides(Scenario(), [("robot.model", model)])
     scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from drake_standup.config import StandupConfig
-from drake_standup.phases import PhaseTable, resolve_com_heights
-from drake_standup.reference import CoMReferenceGenerator, min_jerk, path
-from drake_standup.state_machine import Measurements, initial_mode, next_mode
+from drake_standup.config.phases import PhaseTable, resolve_com_heights
+from drake_standup.standup.com_path import CoMReferenceGenerator, min_jerk, path
+from drake_standup.standup.state_machine import Measurements, initial_mode, next_mode
 
 SEGMENT = np.array([0.7, 1.5, 0.06, 0.0, 0.38, 0.1277, -0.01, 0.03])  # psi_e, T, x0, delta
 

@@ -1,4 +1,4 @@
-"""The iCub model (drake_standup.robot) against values taken outside Drake.
+"""The iCub model (drake_standup.robot.icub) against values taken outside Drake.
 
 Reference values come from the icub-models URDF read with xml.etree, from
 models/icub_contact.yaml read with PyYAML and from models/chair.sdf and
@@ -25,7 +25,7 @@ from pydrake.multibody.tree import RevoluteJoint
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import Scenario
-from drake_standup.robot import (
+from drake_standup.robot.icub import (
     DEFAULT_MODEL,
     ContactModel,
     ModelError,
@@ -33,7 +33,7 @@ from drake_standup.robot import (
     add_icub,
     load_contact_model,
 )
-from drake_standup.scene import add_scene, set_seated_state
+from drake_standup.world.scene import add_scene, set_seated_state
 
 REPO = Path(__file__).resolve().parent.parent
 URDF = Path(icub_models.get_model_file(DEFAULT_MODEL))
@@ -456,7 +456,7 @@ def test_reflected_inertia_is_ratio_squared_times_rotor_on_the_motor_joints():
 
 
 def test_reflected_inertia_setting_by_model():
-    from drake_standup.robot import reflects_motor_inertia
+    from drake_standup.robot.icub import reflects_motor_inertia
 
     assert not reflects_motor_inertia("none", "iCubGenova04")
     assert reflects_motor_inertia("all", "iCubGazeboV2_5")
@@ -479,7 +479,7 @@ def test_scene_gives_the_motors_their_inertia_per_setting(model, setting, expect
     """The scenario's plant (which the controller's model is) has the knee's motor
     reflected inertia, 100^2 x 0.0827e-4 kg m^2, exactly where the setting says."""
     from drake_standup.config import load_scenario
-    from drake_standup.station import make_station
+    from drake_standup.world.station import make_station
 
     overrides = [("robot.model", model)]
     if setting is not None:

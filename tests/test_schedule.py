@@ -11,15 +11,15 @@ from pydrake.common.value import Value
 from pydrake.systems.analysis import Simulator
 
 from drake_standup.config import ControllerConfig
-from drake_standup.control.schedule import (
+from drake_standup.config.phases import PhaseTable
+from drake_standup.standup.contact_schedule import (
     CONTACTS,
     ContactScheduler,
     contact_commands,
     next_unload_from,
     phase_seat_hold,
 )
-from drake_standup.phases import PhaseTable
-from drake_standup.state_machine import Measurements, _enter, _sit_back, initial_mode
+from drake_standup.standup.state_machine import Measurements, _enter, _sit_back, initial_mode
 
 CONFIG = ControllerConfig()
 TABLE = PhaseTable()

@@ -8,7 +8,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from drake_standup.robot import original_urdf
+from drake_standup.robot.icub import original_urdf
 
 pytestmark = pytest.mark.slow
 
@@ -89,7 +89,7 @@ def test_psi_equals_time_without_a_pull(seated_run):
 def test_psi_equals_time_with_advancement_disabled():
     """A pull from t = 0.5 s, advancement off: psi = t, psi_dot = 1 exactly."""
     from drake_standup.config import SCENARIO_DIR, load_scenario
-    from drake_standup.simulate import simulate
+    from drake_standup.sim.simulate import simulate
 
     scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
     scenario.advancement.enabled = False
@@ -109,7 +109,7 @@ def test_the_default_standing_height_is_the_erect_posture():
     from pydrake.systems.framework import DiagramBuilder
 
     from drake_standup.config import Scenario
-    from drake_standup.scene import add_scene, erect_com_height_m
+    from drake_standup.world.scene import add_scene, erect_com_height_m
 
     scenario = Scenario()
     scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)

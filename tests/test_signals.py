@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drake_standup.signals import load_signals, write_signals
+from drake_standup.outputs.signals import load_signals, write_signals
 
 pytestmark = pytest.mark.slow
 
@@ -111,7 +111,7 @@ def test_a_recording_does_not_change_the_simulation():
     so the same 0.6 s of the assisted scenario, with the pull from 0.1 s, is
     bitwise the same with and without the recording."""
     from drake_standup.config import SCENARIO_DIR, load_scenario
-    from drake_standup.simulate import simulate
+    from drake_standup.sim.simulate import simulate
 
     scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
     scenario.duration_s = 0.6
@@ -134,7 +134,7 @@ def test_a_recording_does_not_change_the_simulation():
     ],
 )
 def test_publish_periods_land_on_whole_plant_steps(period, step, expected):
-    from drake_standup.diagram import on_step_grid
+    from drake_standup.sim.diagram import on_step_grid
 
     result = on_step_grid(period, step)
     assert result == pytest.approx(expected, rel=1e-12)
@@ -148,8 +148,8 @@ def test_the_psi_equals_t_run_in_its_own_process_equals_one_run_here(monkeypatch
     nothing of the scenario."""
     import sys
 
-    from drake_standup.baseline import Baseline
     from drake_standup.config import SCENARIO_DIR, load_scenario
+    from drake_standup.sim.baseline import Baseline
 
     scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
     scenario.duration_s = 0.8

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
-from drake_standup.diagram import build_diagram
-from drake_standup.scene import erect_com_height_m
-from drake_standup.signals import load_signals
-from drake_standup.simulate import simulate
+from drake_standup.outputs.signals import load_signals
+from drake_standup.sim.diagram import build_diagram
+from drake_standup.sim.simulate import simulate
+from drake_standup.world.scene import erect_com_height_m
 
 pytestmark = pytest.mark.slow
 
@@ -290,7 +290,7 @@ def _hand_positions(scenario, sig) -> np.ndarray:
     from pydrake.common.eigen_geometry import Quaternion
     from pydrake.math import RigidTransform
 
-    from drake_standup.station import make_station
+    from drake_standup.world.station import make_station
 
     station = make_station(scenario)
     plant, robot = station.plant, station.robot
@@ -315,7 +315,7 @@ def test_the_helpers_work_is_force_times_the_hands_displacement(assisted_run):
     p from forward kinematics of the logged poses. The same work from the logged
     velocities (the trapezoid rule on 10 ms samples of a 4 ms plant) is within 5 %
     (test_advancement checks the velocities themselves)."""
-    from drake_standup.metrics import helper_metrics
+    from drake_standup.outputs.metrics import helper_metrics
 
     scenario, m, sig = assisted_run
     t = sig["time_s"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drake_standup.metrics import helper_metrics, path_deviation_max_m, standup_metrics
+from drake_standup.outputs.metrics import helper_metrics, path_deviation_max_m, standup_metrics
 
 PADS = {
     "l_sole_pad": "soles",

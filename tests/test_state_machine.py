@@ -12,8 +12,8 @@ import pytest
 from pydrake.systems.analysis import Simulator
 
 from drake_standup.config import StandupConfig
-from drake_standup.phases import PhaseTable
-from drake_standup.state_machine import (
+from drake_standup.config.phases import PhaseTable
+from drake_standup.standup.state_machine import (
     GuardSignals,
     Measurements,
     SchmittTrigger,

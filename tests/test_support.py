@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drake_standup.sensing import StandingSupport, standing_pull_usage
+from drake_standup.world.sensing import StandingSupport, standing_pull_usage
 
 WEIGHT_N = 324.0
 SUPPORT = StandingSupport(

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from drake_standup.config import SCENARIO_DIR, apply_overrides, load_scenario
-from drake_standup.sweep import main, run_one, run_sweep
-from drake_standup.sweep_file import SweepError, expand, load_sweep
-from drake_standup.sweep_table import read_table, simulation_rows
+from drake_standup.studies.sweep import main, run_one, run_sweep
+from drake_standup.studies.sweep_file import SweepError, expand, load_sweep
+from drake_standup.studies.sweep_table import read_table, simulation_rows
 
 
 def _write(tmp_path: Path, text: str, name: str = "sweep.yaml") -> Path:
@@ -336,7 +336,7 @@ def test_sweep_bench_runs_the_same_sweep_on_each_worker_count(tmp_path, capsys):
     """The throughput benchmark's mechanics (not its numbers: no timing test)."""
     import json
 
-    from drake_standup import sweep_bench
+    from drake_standup.studies import sweep_bench
 
     spec = _write(tmp_path, SMALL)
     out = tmp_path / "bench"
@@ -354,7 +354,7 @@ def test_a_rate_figure_draws_its_reference_lines(tmp_path):
     """The lines of a figure end up on the axes, at their x (matplotlib's own record)."""
     from unittest import mock
 
-    from drake_standup.sweep_figures import Figure, draw_figure
+    from drake_standup.studies.sweep_figures import Figure, draw_figure
 
     records = [
         {

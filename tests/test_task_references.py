@@ -16,9 +16,11 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import ControllerConfig, Scenario
 from drake_standup.config.inputs import TASK_FRAMES
+from drake_standup.config.phases import PHASES, PhaseTable
 from drake_standup.control.model import HANDS, ControllerJoints
 from drake_standup.control.qp import as_slice
-from drake_standup.control.references import (
+from drake_standup.control.terms import RobotKinematics
+from drake_standup.standup.task_references import (
     ADVANCEMENT,
     COMPLIANT,
     STIFF,
@@ -27,10 +29,8 @@ from drake_standup.control.references import (
     TaskReferenceGenerator,
     static_lean,
 )
-from drake_standup.control.terms import RobotKinematics
-from drake_standup.phases import PHASES, PhaseTable
-from drake_standup.scene import add_scene, set_seated_state
-from drake_standup.sensing import StandingSupport, standing_lean, standing_pull_usage
+from drake_standup.world.scene import add_scene, set_seated_state
+from drake_standup.world.sensing import StandingSupport, standing_lean, standing_pull_usage
 
 T = 0.004
 CONFIG = ControllerConfig()

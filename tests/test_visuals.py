@@ -11,9 +11,9 @@ import numpy as np
 from pydrake.math import RigidTransform
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
-from drake_standup.live import STAND_UP
-from drake_standup.simulate import simulate
-from drake_standup.visuals import (
+from drake_standup.sim.live import STAND_UP
+from drake_standup.sim.simulate import simulate
+from drake_standup.sim.visuals import (
     ARROW_HEAD_M,
     COM_SIDE_OFFSET_M,
     PREFIX,

@@ -23,8 +23,8 @@ from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config.errors import ScenarioError
+from drake_standup.config.resources import model_file
 from drake_standup.config.scenario import chair_file
-from drake_standup.resources import model_file
 
 # --- Files and folders -------------------------------------------------------------------
 

@@ -12,8 +12,8 @@ import math
 from collections.abc import Callable
 
 from drake_standup.config.errors import ScenarioError
+from drake_standup.config.phases import PHASES
 from drake_standup.config.rules import NON_NEGATIVE, POSITIVE, Range
-from drake_standup.phases import PHASES
 
 _STATES = range(1, len(PHASES) + 1)
 

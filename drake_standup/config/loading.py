@@ -19,9 +19,9 @@ from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import read_text_file
 from drake_standup.config.legacy import read_legacy
+from drake_standup.config.resources import find, shipped
 from drake_standup.config.rules import _format, _nodes, _pattern, validate
 from drake_standup.config.scenario import DEFAULT_SCENARIO, Scenario
-from drake_standup.resources import find, shipped
 
 
 def load_scenario(path: str | Path | None = None, overrides: Iterable = ()) -> Scenario:

@@ -18,8 +18,8 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 from drake_standup.config.controller import QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
+from drake_standup.config.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
 from drake_standup.config.scenario import REFLECTED_INERTIA, RESPONSES, Scenario
-from drake_standup.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
 
 
 @dataclass(frozen=True)

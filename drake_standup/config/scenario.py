@@ -12,8 +12,8 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
 from drake_standup.config.controller import ControllerConfig
-from drake_standup.phases import PhaseTable
-from drake_standup.resources import data_root
+from drake_standup.config.phases import PhaseTable
+from drake_standup.config.resources import data_root
 
 SCENARIO_DIR = data_root() / "scenarios"
 DEFAULT_SCENARIO = SCENARIO_DIR / "assisted.yaml"
@@ -363,7 +363,7 @@ class Scenario:
     duration_s: float = 5.0
     # Drake's own plant settings: discrete 'similar' (SPEC 5: 'lagged' and
     # 'similar' ran 1.4-2.2x faster than real time, SAP 0.6x), stepped at 4 ms for
-    # speed: in the convergence study (python -m drake_standup.convergence,
+    # speed: in the convergence study (python -m drake_standup.studies.convergence,
     # docs/performance.md) 4 ms keeps every stand-up time within 0.04 s of 1 ms but
     # fails the assisted CoM path's timing and, without motor inertia, the seated
     # load split; 2 ms with robot.reflected_inertia all passes strictly. 1 ms:

@@ -18,6 +18,6 @@
                    contact commands -> torques; adding a task is adding an object to its
                    list (make_program), not editing the QP
 
-drake_standup/standup_controller.py wires them with the state machine, the advancement
+drake_standup/standup/standup_controller.py wires them with the state machine, the advancement
 and the CoM reference into the stand-up controller's diagram.
 """

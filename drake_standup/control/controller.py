@@ -31,12 +31,11 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import BasicVector, Context, DiscreteValues, LeafSystem
 
 from drake_standup.config import ControllerConfig
+from drake_standup.config.phases import PhaseTable
 from drake_standup.control.contacts import NORMAL, WRENCH_SIZE, ContactSpec
 from drake_standup.control.model import ControllerJoints
 from drake_standup.control.qp import ContactCommands as QpContactCommands
 from drake_standup.control.qp import ContactMap, QpSolution, WholeBodyQp
-from drake_standup.control.references import joint_values
-from drake_standup.control.schedule import CONTACTS, HOLDS, THIGH_HOLDS, ContactCommands
 from drake_standup.control.tasks import (
     BaseOrientationTask,
     CopCenteringTask,
@@ -45,8 +44,9 @@ from drake_standup.control.tasks import (
     PostureTask,
     StancePostureTask,
 )
-from drake_standup.payloads import VectorLayout
-from drake_standup.phases import PhaseTable
+from drake_standup.ports.payloads import VectorLayout
+from drake_standup.standup.contact_schedule import CONTACTS, HOLDS, THIGH_HOLDS, ContactCommands
+from drake_standup.standup.task_references import joint_values
 
 DIAGNOSTICS = VectorLayout(
     ("qp_ok", 1),  # 1 if this tick's QP succeeded, else 0 (torques held)

@@ -50,8 +50,8 @@ import numpy as np
 
 from drake_standup.control.backends import make_backend
 from drake_standup.control.contacts import WRENCH_SIZE, ContactSpec, wrench_cone_matrix
-from drake_standup.control.references import STATES, TaskReferences
 from drake_standup.control.terms import RobotTerms
+from drake_standup.standup.task_references import STATES, TaskReferences
 
 N_BASE = 6  # unactuated floating-base velocities
 

@@ -29,7 +29,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 
 from drake_standup.control.spatial import cross, rotation_from_quaternion
-from drake_standup.robot import Robot
+from drake_standup.robot.icub import Robot
 
 BASE_BODY = "root_link"
 

@@ -1,0 +1,220 @@
+"""The run's metrics (metrics.json) from its signals: seated balance, advancement, the
+stand-up and how it ended."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drake_standup.outputs.signals import group_normal_forces
+from drake_standup.world.human import HELPER_SPENT
+from drake_standup.world.scene import erect_com_height_m
+
+
+def seated_metrics(signals: dict[str, np.ndarray], weight_N: float, settle_s: float = 0.5) -> dict:
+    """CoM drift after settling and the contact forces at the end of the run."""
+    t = signals["time_s"]
+    com = signals["com_W"]
+    metrics: dict = {"weight_N": weight_N}
+    if len(t) == 0:
+        return metrics
+    after = t >= settle_s
+    if after.any():
+        drift = np.linalg.norm(com[after] - com[np.argmax(after)], axis=1)
+        metrics["com_drift_after_settle_m"] = float(drift.max())
+    metrics["com_final_m"] = com[-1]
+    final = signals["pad_forces_W"][-1]  # (pads, 3)
+    metrics["contact_force_N"] = {str(n): final[i] for i, n in enumerate(signals["pad_names"])}
+    metrics["contact_normal_force_N"] = {
+        g: float(fz[-1]) for g, fz in group_normal_forces(signals).items()
+    }
+    metrics["contact_force_total_N"] = final.sum(axis=0)
+    return metrics
+
+
+def advancement_metrics(
+    psi_final: float, psi_dot: np.ndarray, entry_times_s: tuple[float, ...]
+) -> dict:
+    """psi at the end, the range of psi_dot, when each state was entered."""
+    if len(psi_dot) == 0:
+        return {"psi_final": float(psi_final)}
+    return {
+        "psi_final": float(psi_final),
+        "psi_dot_min": float(np.min(psi_dot)),
+        "psi_dot_max": float(np.max(psi_dot)),
+        "state_entry_times_s": [None if np.isnan(t) else float(t) for t in entry_times_s],
+    }
+
+
+def standup_metrics(
+    signals: dict[str, np.ndarray],
+    entry_times_s,
+    *,
+    standing_height_m: float | None = None,
+    height_tolerance_m: float = 0.01,
+    unloaded_N: float = 5.0,
+    hold_s: float = 0.2,
+) -> dict:
+    """Stand-up time, CoM tracking and whether the robot is standing at the end.
+
+    The stand-up is measured from its outcome, not from a guard's instant. Standing at a
+    sample: the CoM within height_tolerance_m of the standing height, and every pad group
+    but the soles (thighs, buttocks) carrying less than unloaded_N in all. The standing
+    height is standing_height_m, the erect height (simulate.py: the CoM height of the
+    state-4 posture, scene.erect_com_height_m); without it, the run's own: the CoM
+    reference's height at the end of the run, once its last segment (state 4) has run
+    through (None otherwise: the run never set it). Where the controller leans the CoM
+    against a pull (signals com_lean_W, a horizontal shift d), the standing height is
+    that of the posture tilted about the feet, sqrt(height^2 - |d|^2).
+    standup_time_s runs from entering state 2 to the first standing sample from which
+    the robot stays standing for hold_s (None if never); standing_at_end: standing at
+    the last sample. 5 N is the unloading level of issue 12's chatter count: 1.5 % of
+    the robot's weight, above the 1-3 N a pad still feels while it lifts off a
+    compliant seat, far below the 50-170 N the thighs carry seated.
+    """
+    t = signals["time_s"]
+    error = np.linalg.norm(signals["com_W"] - signals["com_reference_W"], axis=1)
+    metrics: dict = {
+        "com_tracking_rms_m": float(np.sqrt(np.mean(error**2))) if len(t) else None,
+        "standing_at_end": False,
+        "standing_com_height_m": None,
+        "standup_time_s": None,
+    }
+    if not len(t):
+        return metrics
+    if standing_height_m is None:
+        done = signals["psi"] - signals["segment_psi_entry"] >= signals["segment_psi_length"]
+        if not (signals["state"][-1] == 4 and done[-1]):
+            return metrics
+        height = float(signals["com_reference_W"][-1, 2])
+    else:
+        height = float(standing_height_m)
+    metrics["standing_com_height_m"] = height
+    seat = [f for g, f in group_normal_forces(signals).items() if g != "soles"]
+    unloaded = np.all(np.array(seat) < unloaded_N, axis=0) if seat else np.ones(len(t), bool)
+    if "com_lean_W" in signals:
+        # Leaning against a pull tilts the standing robot about its feet: the erect
+        # height is then that of the tilted posture (the controller's own target).
+        lean = signals["com_lean_W"]
+        height = np.sqrt(np.maximum(height**2 - lean[:, 0] ** 2 - lean[:, 1] ** 2, 0.0))
+    standing = (np.abs(signals["com_W"][:, 2] - height) <= height_tolerance_m) & unloaded
+    metrics["standing_at_end"] = bool(standing[-1])
+    # Standing from sample i through t[i] + hold_s: no non-standing sample up to the
+    # last sample within the hold, and the run lasts that long.
+    not_standing = np.r_[0, np.cumsum(~standing)]
+    last = np.searchsorted(t, t + hold_s - 1e-9, side="right") - 1
+    held = (not_standing[last + 1] - not_standing[:-1] == 0) & (t[-1] >= t + hold_s - 1e-9)
+    t2 = entry_times_s[1]
+    if t2 is not None and np.isfinite(t2):
+        held &= t >= t2
+        if held.any():
+            metrics["standup_time_s"] = float(t[np.argmax(held)] - t2)
+    return metrics
+
+
+def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
+    """int y dt by the trapezoid rule (numpy < 2 has no np.trapezoid)."""
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
+
+
+def helper_metrics(
+    time_s: np.ndarray, hand_wrenches_W: np.ndarray, hand_velocities_W: np.ndarray
+) -> dict:
+    """What the helper spent, from the hands' measured forces (hand_wrenches_W: N x 12,
+    [tau_l, f_l, tau_r, f_r]) and the velocities of the points they pull
+    (hand_velocities_W: N x 6, [v_l, v_r]), by the trapezoid rule on the samples:
+    helper_work_J = int F . v dt over both hands; helper_positive_work_J its positive
+    part, int max(F . v, 0) dt; helper_peak_force_N the larger hand's peak |f|;
+    helper_impulse_Ns = int (|f_l| + |f_r|) dt."""
+    f = np.stack([hand_wrenches_W[:, 3:6], hand_wrenches_W[:, 9:12]], axis=1)  # N x 2 x 3
+    v = hand_velocities_W.reshape(len(time_s), 2, 3)
+    power_W = np.einsum("nhk,nhk->n", f, v)
+    magnitude_N = np.linalg.norm(f, axis=2)  # N x 2
+    return {  # the trapezoid rule gives 0 on fewer than two samples
+        "helper_work_J": _trapezoid(power_W, time_s),
+        "helper_positive_work_J": _trapezoid(np.maximum(power_W, 0.0), time_s),
+        "helper_peak_force_N": float(magnitude_N.max()) if magnitude_N.size else 0.0,
+        "helper_impulse_Ns": _trapezoid(magnitude_N.sum(axis=1), time_s),
+    }
+
+
+def path_deviation_max_m(points_W: np.ndarray, path_W: np.ndarray) -> float | None:
+    """The largest distance from a point (N x 3: the CoM) to a path given by its samples
+    in order (M x 3: the CoM reference x_d(psi) as psi ran), the polyline through them:
+    how far the CoM strays from the path, not from where the reference is at time t."""
+    if not len(points_W) or not len(path_W):
+        return None
+    a = path_W[:-1]
+    ab = path_W[1:] - a
+    length2 = np.einsum("mk,mk->m", ab, ab)
+    keep = length2 > 0.0  # repeated samples (psi held) are no segment
+    a, ab, length2 = a[keep], ab[keep], length2[keep]
+    if not len(a):  # the reference never moved: the distance to its one point
+        return float(np.linalg.norm(points_W - path_W[0], axis=1).max())
+    worst = 0.0
+    for chunk in np.array_split(points_W, max(1, len(points_W) // 256)):
+        ap = chunk[:, None, :] - a[None, :, :]  # n x m x 3
+        u = np.clip(np.einsum("nmk,mk->nm", ap, ab) / length2, 0.0, 1.0)
+        nearest = a[None] + u[..., None] * ab[None]
+        d = np.linalg.norm(chunk[:, None, :] - nearest, axis=2).min(axis=1)
+        worst = max(worst, float(d.max()))
+    return worst
+
+
+def run_metrics(
+    signals: dict[str, np.ndarray],
+    station,
+    *,
+    station_context,
+    scenario,
+    psi_final: float | None,
+    entry_times_s: tuple[float, ...],
+) -> dict:
+    """metrics.json's entries of a run from its signals: the seated balance and the final
+    contact forces, the robot's mass (the model's, and the simulated one with
+    perturbation.mass_scale), and with the stand-up controller (psi_final given) the
+    advancement, the stand-up against the erect height (scene.erect_com_height_m of the
+    rise's posture) and the controller's QP, joint-limit, mass-estimate and waiting
+    figures; the peak joint torque."""
+    plant, instance = station.plant, station.robot.model_instance
+    mass_kg = plant.CalcTotalMass(plant.CreateDefaultContext(), [instance])
+    simulated_mass_kg = plant.CalcTotalMass(station_context, [instance])
+    g = -plant.gravity_field().gravity_vector()[2]
+    metrics = seated_metrics(signals, weight_N=simulated_mass_kg * g)
+    metrics["robot_mass_kg"] = mass_kg
+    metrics["simulated_mass_kg"] = simulated_mass_kg
+    samples = len(signals["time_s"])
+    if psi_final is not None:
+        metrics.update(advancement_metrics(psi_final, signals["psi_dot"], entry_times_s))
+        height = erect_com_height_m(station.scene, scenario, scenario.phases.rise.posture_rad)
+        metrics.update(
+            standup_metrics(signals, metrics["state_entry_times_s"], standing_height_m=height)
+        )
+        metrics["qp_failures"] = int(signals["qp_failures"][-1]) if samples else 0
+    if samples and "qp_ok" in signals:
+        slack = signals["joint_limit_slack"]
+        metrics["joint_limit_slack_peak"] = float(slack.max())
+        step = signals["time_s"][1] - signals["time_s"][0] if len(slack) > 1 else 0.0
+        metrics["joint_limit_slack_integral"] = float(np.sum(slack) * step) if step else 0.0
+        # Ticks the QP was solved only with its contacts relaxed (control/qp.py).
+        metrics["qp_relaxed_ticks"] = int(signals["qp_relaxed"][-1])
+        # The robot's mass as the controller estimated it (weighing itself seated).
+        metrics["model_mass_kg"] = float(signals["model_mass_scale"][-1] * mass_kg)
+        # How long the stand-up waited for a pull against it to stop (state machine).
+        metrics["held_back_s"] = float(signals["held_back_s"][-1])
+        if "held_back_beyond_feet_s" in signals:  # signals.npz before issue 21 lack it
+            metrics["held_back_beyond_feet_s"] = float(signals["held_back_beyond_feet_s"][-1])
+    if samples and "helper_work_J" in signals:  # the plant's steps' totals (HelperWork)
+        metrics.update({name: float(signals[name][-1]) for name in HELPER_SPENT})
+    elif "hand_velocities_W" in signals:  # the logged samples only
+        metrics.update(
+            helper_metrics(
+                signals["time_s"], signals["hand_wrenches_W"], signals["hand_velocities_W"]
+            )
+        )
+    if "com_reference_W" in signals:
+        metrics["path_deviation_max_m"] = path_deviation_max_m(
+            signals["com_W"], signals["com_reference_W"]
+        )
+    torques = signals["joint_torques_Nm"]
+    metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
+    return metrics

@@ -1,0 +1,1 @@
+"""The named payloads between systems and their cached outputs (the lowest layer)."""

@@ -1,0 +1,470 @@
+"""The iCub from icub-models, made Drake-ready.
+
+What this module does to the published URDF, in order:
+  1. Converts its STL visuals to decimated OBJ in a cache (meshes.py); Drake
+     reads no STL.
+  2. Drops every URDF collision element: the task needs contact only where the
+     robot meets chair and floor, given as primitives in models/icub_contact.yaml.
+  3. Optionally ("reduced") removes the massless, visual-less links that hang
+     on fixed joints (sensor and skin frames, about 170 of the 210 links) and
+     adds each back as a FixedOffsetFrame on its nearest kept ancestor, so
+     every named frame survives while the tree Drake integrates shrinks to
+     about 40 bodies (same mass matrix, CoM and frame poses; tests check it).
+  4. Adds a JointActuator per revolute joint with the scenario's effort limit and,
+     if asked, the motor's rotor inertia and gear ratio (MOTOR_INERTIAS).
+"""
+
+import copy
+import hashlib
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from pydrake.common.yaml import yaml_load_typed
+from pydrake.geometry import (
+    AddCompliantHydroelasticProperties,
+    AddContactMaterial,
+    Box,
+    Capsule,
+    Ellipsoid,
+    GeometryId,
+    ProximityProperties,
+    Sphere,
+)
+from pydrake.math import RigidTransform, RollPitchYaw
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
+from pydrake.multibody.tree import (
+    FixedOffsetFrame,
+    JointActuator,
+    ModelInstanceIndex,
+    PdControllerGains,
+    RevoluteJoint,
+)
+
+from drake_standup.config.inputs import CONTACT_FILE, TASK_FRAMES, robot_names
+from drake_standup.config.scenario import EFFORT_LIMIT_NM, REFLECTED_INERTIA
+from drake_standup.robot.meshes import cache_dir, converted_obj
+
+DEFAULT_MODEL = "iCubGazeboV2_5"
+
+# The motors of the authors' controller model (SPEC 9): gear ratio 100 on every joint;
+# rotor inertia 0.0827e-4 kg m^2 on the legs and torso pitch/roll, 0.0585e-4 on torso yaw
+# and the arms. Drake reflects it as ratio^2 x rotor on the joint (0.0827 and 0.0585 kg m^2):
+# diagonal, where the authors' model also couples the shoulder's and torso's tendon-driven
+# joints. Joints the authors did not list (neck, wrists) keep none.
+MOTOR_GEAR_RATIO = 100.0
+MOTOR_INERTIAS: dict[str, float] = {
+    **{
+        f"{side}_{joint}": 0.0827e-4
+        for side in "lr"
+        for joint in ("hip_pitch", "hip_roll", "hip_yaw", "knee", "ankle_pitch", "ankle_roll")
+    },
+    "torso_pitch": 0.0827e-4,
+    "torso_roll": 0.0827e-4,
+    "torso_yaw": 0.0585e-4,
+    **{
+        f"{side}_{joint}": 0.0585e-4
+        for side in "lr"
+        for joint in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
+    },
+}
+
+
+def reflects_motor_inertia(setting: str, model_name: str) -> bool:
+    """Whether robot.reflected_inertia (REFLECTED_INERTIA) turns it on for this model:
+    real_robots means every model but the Gazebo ones, which model no motors."""
+    if setting not in REFLECTED_INERTIA:
+        raise ValueError(
+            f"robot.reflected_inertia: '{setting}'; accepted: none | all | real_robots"
+        )
+    return setting == "all" or (setting == "real_robots" and "Gazebo" not in model_name)
+
+
+class ModelError(ValueError):
+    """Raised for a robot model that cannot be loaded (one-line message)."""
+
+
+def original_urdf(model_name: str) -> Path:
+    """Path of the URDF that icub-models installs for model_name."""
+    import icub_models
+
+    names = robot_names()
+    if model_name not in names:
+        raise ModelError(f"robot.model: unknown model '{model_name}'; accepted: {', '.join(names)}")
+    return Path(icub_models.get_model_file(model_name))
+
+
+def _pose(elem: ET.Element | None) -> RigidTransform:
+    """Pose of a URDF <origin> (fixed-axis roll-pitch-yaw, as Drake's RPY)."""
+    if elem is None:
+        return RigidTransform()
+    xyz = [float(s) for s in elem.get("xyz", "0 0 0").split()]
+    rpy = [float(s) for s in elem.get("rpy", "0 0 0").split()]
+    return RigidTransform(RollPitchYaw(rpy), xyz)
+
+
+def _is_bare(link: ET.Element) -> bool:
+    """True for a link that carries no mass and shows nothing."""
+    if link.find("visual") is not None:
+        return False
+    inertial = link.find("inertial")
+    if inertial is None:
+        return True
+    mass = inertial.find("mass")
+    return mass is None or float(mass.get("value", "0")) == 0.0
+
+
+@dataclass
+class LeafFrame:
+    """A removed bare link, kept as a frame fixed on its nearest kept ancestor."""
+
+    name: str
+    parent_body: str
+    X_PF: RigidTransform
+
+
+@dataclass
+class PreparedUrdf:
+    """A Drake-ready URDF in the cache and the frames to re-attach after parsing."""
+
+    path: Path
+    leaf_frames: list[LeafFrame]
+
+
+# prepare_urdf's results in this process, by its arguments and the cache directory.
+_PREPARED: dict[tuple, PreparedUrdf] = {}
+
+
+def prepare_urdf(
+    model_name: str = DEFAULT_MODEL,
+    *,
+    reduce: bool = True,
+    visuals: bool = True,
+    visual_max_faces: int = 1000,
+) -> PreparedUrdf:
+    """Rewrites the icub-models URDF for Drake (see the module docstring).
+
+    Once per process and arguments while the cached file exists: the rewrite
+    (parse, mesh look-ups, serialise, hash) cost ~15 ms of every
+    build_diagram, which a sweep pays for every run (measured)."""
+    key = (model_name, reduce, visuals, visual_max_faces, str(cache_dir()))
+    prepared = _PREPARED.get(key)
+    if prepared is None or not prepared.path.exists():
+        prepared = _PREPARED[key] = _prepare_urdf(
+            model_name, reduce=reduce, visuals=visuals, visual_max_faces=visual_max_faces
+        )
+    return PreparedUrdf(prepared.path, list(prepared.leaf_frames))
+
+
+def _prepare_urdf(
+    model_name: str, *, reduce: bool, visuals: bool, visual_max_faces: int
+) -> PreparedUrdf:
+    src = original_urdf(model_name)
+    share_icub = src.parent.parent.parent  # .../share/iCub (package://iCub/)
+    tree = ET.parse(src)
+    robot = tree.getroot()
+
+    for tag in ("gazebo", "sensor"):
+        for elem in robot.findall(tag):
+            robot.remove(elem)
+
+    links = {link.get("name"): link for link in robot.findall("link")}
+    for link in links.values():
+        for col in link.findall("collision"):
+            link.remove(col)
+        for vis in link.findall("visual"):
+            mesh = vis.find("geometry/mesh")
+            if not visuals:
+                link.remove(vis)
+            elif mesh is not None:
+                uri = mesh.get("filename")
+                stl = share_icub / uri.removeprefix("package://iCub/")
+                scale = [float(s) for s in mesh.get("scale", "1 1 1").split()]
+                mesh.set("filename", str(converted_obj(stl, scale, visual_max_faces)))
+                mesh.attrib.pop("scale", None)
+
+    leaf_frames: list[LeafFrame] = []
+    if reduce:
+        leaf_frames = _remove_bare_subtrees(robot, links)
+
+    digest = hashlib.sha1(ET.tostring(robot)).hexdigest()[:12]
+    kind = "reduced" if reduce else "full"
+    out = cache_dir() / "urdf" / f"{model_name}-{kind}-{digest}.urdf"
+    if not out.exists():
+        out.parent.mkdir(parents=True, exist_ok=True)
+        # Write then rename: a half-written file must never look cached.
+        tmp = out.with_name(f"{out.name}.{os.getpid()}.tmp")
+        tree.write(tmp)
+        tmp.replace(out)
+    return PreparedUrdf(out, leaf_frames)
+
+
+def _remove_bare_subtrees(robot: ET.Element, links: dict[str, ET.Element]) -> list[LeafFrame]:
+    """Removes every subtree of bare links on fixed joints; returns their frames."""
+    joints = robot.findall("joint")
+    children: dict[str, list[ET.Element]] = {name: [] for name in links}
+    parent_joint: dict[str, ET.Element] = {}
+    for joint in joints:
+        children[joint.find("parent").get("link")].append(joint)
+        parent_joint[joint.find("child").get("link")] = joint
+
+    def child_of(joint: ET.Element) -> str:
+        return joint.find("child").get("link")
+
+    def removable(name: str) -> bool:
+        joint = parent_joint.get(name)
+        return (
+            joint is not None
+            and joint.get("type") == "fixed"
+            and _is_bare(links[name])
+            and all(removable(child_of(j)) for j in children[name])
+        )
+
+    frames: list[LeafFrame] = []
+
+    def collect(name: str, kept: str, X_KL: RigidTransform) -> None:
+        frames.append(LeafFrame(name, kept, X_KL))
+        for j in children[name]:
+            collect(child_of(j), kept, X_KL @ _pose(j.find("origin")))
+
+    for joint in joints:
+        parent = joint.find("parent").get("link")
+        if removable(child_of(joint)) and not removable(parent):
+            collect(child_of(joint), parent, _pose(joint.find("origin")))
+    removed = {f.name for f in frames}
+    for joint in joints:
+        if child_of(joint) in removed:
+            robot.remove(joint)
+    for name in removed:
+        robot.remove(links[name])
+    return frames
+
+
+# --- Contact geometry --------------------------------------------------------
+
+
+@dataclass
+class ContactShape:
+    """One contact primitive, posed in a named robot frame."""
+
+    name: str = ""
+    frame: str = ""
+    shape: str = "box"  # box | capsule | ellipsoid | sphere
+    # box: [x, y, z] edge lengths; capsule: [radius, length]; ellipsoid: [a, b, c]
+    # semi-axes; sphere: [radius]. Metres.
+    size_m: list[float] = field(default_factory=list)
+    xyz_m: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    rpy_rad: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    group: str = ""  # sole | thigh | buttocks: how contact forces are reported
+
+
+@dataclass
+class NamedFrame:
+    """A frame added to the robot, posed in an existing robot frame."""
+
+    name: str = ""
+    parent: str = ""
+    xyz_m: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    rpy_rad: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+@dataclass
+class ContactModel:
+    """Hydroelastic parameters and primitives for the robot (models/icub_contact.yaml)."""
+
+    hydroelastic_modulus_Pa: float = 1.0e6
+    resolution_hint_m: float = 0.02
+    hunt_crossley_dissipation_s_per_m: float = 5.0
+    friction_coefficient: float = 1.0
+    frames: list[NamedFrame] = field(default_factory=list)
+    shapes: list[ContactShape] = field(default_factory=list)
+
+
+# Parsed contact models by (path, modification time): parsing the YAML took
+# ~3 ms of every build_diagram (measured).
+_CONTACT_MODELS: dict[tuple[str, int], ContactModel] = {}
+
+
+def load_contact_model(path: Path = CONTACT_FILE) -> ContactModel:
+    """The contact model in path (a fresh copy: the caller may change it)."""
+    path = Path(path)
+    key = (str(path.resolve()), path.stat().st_mtime_ns)
+    model = _CONTACT_MODELS.get(key)
+    if model is None:
+        model = _CONTACT_MODELS[key] = yaml_load_typed(schema=ContactModel, filename=str(path))
+    return copy.deepcopy(model)
+
+
+def _shape(spec: ContactShape):
+    s = spec.size_m
+    expected = {"box": 3, "capsule": 2, "ellipsoid": 3, "sphere": 1}
+    if spec.shape not in expected:
+        raise ModelError(
+            f"contact shape '{spec.name}': shape '{spec.shape}' unknown; "
+            f"accepted: {', '.join(expected)}"
+        )
+    if len(s) != expected[spec.shape]:
+        raise ModelError(f"contact shape '{spec.name}': size_m needs {expected[spec.shape]} values")
+    if spec.shape == "box":
+        return Box(*s)
+    if spec.shape == "capsule":
+        return Capsule(*s)
+    if spec.shape == "ellipsoid":
+        return Ellipsoid(*s)
+    return Sphere(*s)
+
+
+# --- Adding the robot to a plant ----------------------------------------------
+
+
+@dataclass
+class Robot:
+    """Handles to the iCub inside a MultibodyPlant."""
+
+    model_instance: ModelInstanceIndex
+    model_name: str
+    joint_names: list[str]  # revolute joints, in actuator order
+    contact_groups: dict[str, list[str]]  # group -> contact geometry names
+    contact_geometries: dict[str, GeometryId]  # contact geometry name -> id
+    contact_shapes: list[ContactShape]
+    leaf_frames: list[LeafFrame]
+
+    # Task frame -> model frame: the controller speaks of hands and soles. The table lives
+    # in config, whose validate checks that a model has these frames (scene_frames).
+    TASK_FRAMES = TASK_FRAMES
+
+    def frame(self, plant: MultibodyPlant, task_name: str):
+        """The plant frame behind a task frame name (see TASK_FRAMES)."""
+        return plant.GetFrameByName(self.TASK_FRAMES[task_name], self.model_instance)
+
+
+def add_icub(
+    plant: MultibodyPlant,
+    model_name: str = DEFAULT_MODEL,
+    *,
+    reduce: bool = True,
+    visuals: bool = True,
+    effort_limit_Nm: float = EFFORT_LIMIT_NM,
+    pd_gains: tuple[float, float] | None = None,
+    contact: ContactModel | None = None,
+    visual_max_faces: int = 1000,
+    motor_inertia: bool = False,
+) -> Robot:
+    """Adds the iCub to plant (before Finalize) and returns its handles.
+
+    pd_gains (Kp [N m/rad], Kd [N m s/rad]) gives every joint Drake's built-in
+    implicit joint PD; None leaves the actuators pure torque sources. motor_inertia:
+    the actuators of MOTOR_INERTIAS' joints get their rotor inertia and gear ratio, so
+    that the plant's mass matrix (and any model of the same plant) has the reflected
+    inertia on their diagonal.
+    """
+    prepared = prepare_urdf(
+        model_name, reduce=reduce, visuals=visuals, visual_max_faces=visual_max_faces
+    )
+    parser = Parser(plant)
+    (instance,) = parser.AddModels(str(prepared.path))
+
+    for leaf in prepared.leaf_frames:
+        parent = plant.GetBodyByName(leaf.parent_body, instance)
+        plant.AddFrame(FixedOffsetFrame(leaf.name, parent.body_frame(), leaf.X_PF))
+
+    contact = contact if contact is not None else load_contact_model()
+    X_BF: dict[str, RigidTransform] = {f.name: f.X_PF for f in prepared.leaf_frames}
+    for spec in contact.frames:
+        parent = plant.GetFrameByName(spec.parent, instance)
+        X_PF = RigidTransform(RollPitchYaw(spec.rpy_rad), spec.xyz_m)
+        X_BF[spec.name] = X_BF.get(spec.parent, RigidTransform()) @ X_PF
+        plant.AddFrame(FixedOffsetFrame(spec.name, parent, X_PF))
+
+    joint_names = []
+    for index in plant.GetJointIndices(instance):
+        joint = plant.get_joint(index)
+        if isinstance(joint, RevoluteJoint):
+            joint_names.append(joint.name())
+            actuator = plant.AddJointActuator(joint.name(), joint, effort_limit_Nm)
+            if motor_inertia and joint.name() in MOTOR_INERTIAS:
+                actuator.set_default_rotor_inertia(MOTOR_INERTIAS[joint.name()])
+                actuator.set_default_gear_ratio(MOTOR_GEAR_RATIO)
+            if pd_gains is not None:
+                kp, kd = pd_gains
+                actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))
+
+    groups: dict[str, list[str]] = {}
+    geometries: dict[str, GeometryId] = {}
+    if plant.geometry_source_is_registered():
+        for spec in contact.shapes:
+            frame = plant.GetFrameByName(spec.frame, instance)
+            X_FG = RigidTransform(RollPitchYaw(spec.rpy_rad), spec.xyz_m)
+            # Before Finalize, frame poses are known only from our own tables.
+            X_BG = X_BF.get(spec.frame, RigidTransform()) @ X_FG
+            props = ProximityProperties()
+            AddContactMaterial(
+                dissipation=contact.hunt_crossley_dissipation_s_per_m,
+                friction=CoulombFriction(
+                    contact.friction_coefficient, contact.friction_coefficient
+                ),
+                properties=props,
+            )
+            AddCompliantHydroelasticProperties(
+                contact.resolution_hint_m, contact.hydroelastic_modulus_Pa, props
+            )
+            geometries[spec.name] = plant.RegisterCollisionGeometry(
+                frame.body(), X_BG, _shape(spec), spec.name, props
+            )
+            groups.setdefault(spec.group, []).append(spec.name)
+    return Robot(
+        instance,
+        model_name,
+        joint_names,
+        groups,
+        geometries,
+        list(contact.shapes),
+        prepared.leaf_frames,
+    )
+
+
+def set_joint_positions(
+    plant: MultibodyPlant, context, instance, positions: dict[str, float]
+) -> None:
+    """Sets revolute joint angles by joint name (never by list position)."""
+    for name, value in positions.items():
+        plant.GetJointByName(name, instance).set_angle(context, float(value))
+
+
+def actuated_vector(plant: MultibodyPlant, instance, values: dict[str, float]) -> np.ndarray:
+    """Vector in actuator order from a name -> value map (missing names are 0)."""
+    out = np.zeros(plant.num_actuated_dofs(instance))
+    for index in plant.GetJointActuatorIndices(instance):
+        actuator: JointActuator = plant.get_joint_actuator(index)
+        out[actuator.input_start()] = values.get(actuator.joint().name(), 0.0)
+    return out
+
+
+@dataclass
+class ActuatedJoints:
+    """The instance's actuated joints in actuation order (the order of the
+    actuation input and net_actuation output), and where each joint's position
+    and velocity sit in the instance's state [q; v]."""
+
+    names: list[str]
+    q_index: np.ndarray  # (n_u,) into the instance's q
+    v_index: np.ndarray  # (n_u,) into the instance's v
+
+
+def actuated_joints(plant: MultibodyPlant, instance: ModelInstanceIndex) -> ActuatedJoints:
+    """The instance's actuated joints (add_icub: one actuator per revolute joint)."""
+    joints = [plant.get_joint(j) for j in plant.GetJointIndices(instance)]
+    first_q = min(j.position_start() for j in joints if j.num_positions() > 0)
+    first_v = min(j.velocity_start() for j in joints if j.num_velocities() > 0)
+    actuators = sorted(
+        (plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(instance)),
+        key=lambda a: a.input_start(),
+    )
+    return ActuatedJoints(
+        names=[a.joint().name() for a in actuators],
+        q_index=np.array([a.joint().position_start() - first_q for a in actuators]),
+        v_index=np.array([a.joint().velocity_start() - first_v for a in actuators]),
+    )

@@ -1,0 +1,234 @@
+"""build_diagram(scenario): the station, the stand-up controller and the human, wired.
+
+The diagram's own output ports are the run's signals, by name (LOGGED, and the visuals'
+inputs); runner.py logs and reads those, never a system's insides.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.geometry import Meshcat, MeshcatVisualizer, MeshcatVisualizerParams, Role
+from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
+from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
+from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
+
+from drake_standup.config import RESPONSES, Scenario, validate
+from drake_standup.control.controller import WholeBodyController
+from drake_standup.robot.icub import actuated_joints
+from drake_standup.sim.visuals import StandupVisuals
+from drake_standup.standup.standup_controller import make_standup_controller
+from drake_standup.world.human import HelperWork, HumanWrenchSource
+from drake_standup.world.scene import Scene, set_seated_state
+from drake_standup.world.station import Station, make_station
+
+CONTROLLERS = ("whole_body", "seat_hold")
+# The diagram's outputs that every run logs (the station's, the controller's, the human's).
+STATION_SIGNALS = (
+    "robot_state",
+    "pad_forces_W",
+    "hand_wrenches_W",
+    "com_W",
+    "net_actuation",
+    "standing_pull_usage",
+    "hand_velocities_W",
+)
+CONTROLLER_SIGNALS = (
+    "psi",
+    "psi_dot",
+    "alpha",
+    "com_reference",
+    "x_d_W",
+    "standup_state",
+    "held_back",
+    "segment",
+    "entry_times_s",
+    "controller_diagnostics",
+    "lean_W",
+    "compliance_W",
+    "mass_estimate",
+)
+# Not logged: the visuals' (every publish) and the table's last values only.
+UNLOGGED = ("x_d_W", "entry_times_s", "applied_hand_wrenches_W")
+
+
+@dataclass
+class StandupDiagram:
+    """The built diagram, the station it simulates and the loggers of its outputs."""
+
+    diagram: Diagram
+    station: Station
+    controller: WholeBodyController | None  # for its compute times (bench.py)
+    logs: dict[str, VectorLogSink]  # output name -> logger
+    visualizer: MeshcatVisualizer | None
+
+    def output(self, name: str, root_context) -> np.ndarray:
+        """The diagram's output name in the root context."""
+        return self.diagram.GetOutputPort(name).Eval(root_context)
+
+
+def build_diagram(
+    scenario: Scenario,
+    meshcat: Meshcat | None = None,
+    controller: str = "whole_body",
+    make_human: Callable | None = None,
+) -> StandupDiagram:
+    """The stand-up diagram: station, human, stand-up controller, loggers and
+    (optionally) Meshcat.
+
+    controller: 'whole_body' (the stand-up controller) or 'seat_hold' (Drake's joint PD
+    holding the seated pose: the plant-only benchmark). make_human(plant, robot,
+    scenario.human): another human with the ports of HumanWrenchSource (live.py's
+    helper at the Meshcat page); an output port stand_up, if it has one, goes to the
+    stand-up controller.
+    """
+    if controller not in CONTROLLERS:
+        raise ValueError(f"controller: '{controller}'; accepted: {', '.join(CONTROLLERS)}")
+    validate(scenario)  # the one check of a scenario's inputs, however it was made
+    hold = scenario.seat_hold
+    seat_hold = controller == "seat_hold"
+    station = make_station(
+        scenario, (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad) if seat_hold else None
+    )
+    builder = DiagramBuilder()
+    world = builder.AddNamedSystem("station", station.diagram)
+    human = builder.AddNamedSystem(
+        "human", (make_human or HumanWrenchSource)(station.plant, station.robot, scenario.human)
+    )
+    builder.Connect(world.GetOutputPort("robot_state"), human.GetInputPort("robot_state"))
+    builder.Connect(
+        human.GetOutputPort("spatial_forces"), world.GetInputPort("hand_spatial_forces")
+    )
+    builder.Connect(
+        human.GetOutputPort("hand_wrenches_W"), world.GetInputPort("applied_hand_wrenches_W")
+    )
+    # What the helper spends, on the plant's own steps (human.HelperWork).
+    spent = builder.AddNamedSystem("helper_work", HelperWork(scenario.plant.time_step))
+    builder.Connect(world.GetOutputPort("hand_positions_W"), spent.GetInputPort("hand_positions_W"))
+    builder.Connect(human.GetOutputPort("hand_wrenches_W"), spent.GetInputPort("hand_wrenches_W"))
+    outputs = {name: world.GetOutputPort(name) for name in STATION_SIGNALS}
+    outputs["applied_hand_wrenches_W"] = human.GetOutputPort("hand_wrenches_W")
+    outputs["helper_spent"] = spent.GetOutputPort("helper_spent")
+    if station.diagram.HasOutputPort("push_force_W"):
+        outputs["push_force_W"] = world.GetOutputPort("push_force_W")
+    standup = None
+    if seat_hold:
+        add_seat_hold(
+            builder,
+            station.scene,
+            scenario,
+            world.GetInputPort("desired_state"),
+            world.GetInputPort("actuation"),
+        )
+    else:
+        standup = make_standup_controller(scenario, station)
+        brain = builder.AddNamedSystem("standup_controller", standup.diagram)
+        # The robot's response to the pull: the scenario's, or the live helper's switch.
+        if human.HasOutputPort("response"):
+            outputs["response"] = human.GetOutputPort("response")
+        else:
+            response = ConstantVectorSource([float(RESPONSES.index(scenario.response))])
+            outputs["response"] = builder.AddNamedSystem("response", response).get_output_port()
+        builder.Connect(outputs["response"], brain.GetInputPort("response"))
+        for i in range(brain.num_input_ports()):
+            port = brain.get_input_port(i)
+            if port.get_name() == "stand_up":
+                if human.HasOutputPort("stand_up"):
+                    builder.Connect(human.GetOutputPort("stand_up"), port)
+            elif port.get_name() != "response":
+                builder.Connect(world.GetOutputPort(port.get_name()), port)
+        builder.Connect(brain.GetOutputPort("actuation"), world.GetInputPort("actuation"))
+        outputs |= {name: brain.GetOutputPort(name) for name in CONTROLLER_SIGNALS}
+    logs = {}
+    for name, port in outputs.items():
+        builder.ExportOutput(port, name)
+        if name not in UNLOGGED:
+            logs[name] = LogVectorOutput(port, builder, scenario.log_period_s)
+            logs[name].set_name(f"log_{name}")
+    visualizer = None
+    if meshcat is not None:
+        visualizer = _add_meshcat(builder, world, scenario, meshcat)
+        if standup is not None:
+            _add_visuals(builder, station, scenario, meshcat, outputs)
+    diagram = builder.Build()
+    diagram.set_name("standup")
+    return StandupDiagram(
+        diagram, station, None if standup is None else standup.controller, logs, visualizer
+    )
+
+
+def _add_meshcat(builder, world, scenario: Scenario, meshcat: Meshcat) -> MeshcatVisualizer:
+    """The scene and its contact forces, on the plant's step grid."""
+    vis, step_s = scenario.visualization, scenario.plant.time_step
+    visualizer = MeshcatVisualizer.AddToBuilder(
+        builder,
+        world.GetOutputPort("query_object"),
+        meshcat,
+        MeshcatVisualizerParams(
+            publish_period=on_step_grid(vis.publish_period_s, step_s), role=Role.kIllustration
+        ),
+    )
+    if vis.show_contact_forces:
+        ContactVisualizer.AddToBuilder(
+            builder,
+            world.GetOutputPort("contact_results"),
+            world.GetOutputPort("query_object"),
+            meshcat,
+            ContactVisualizerParams(
+                publish_period=on_step_grid(vis.contact_publish_period_s, step_s),
+                newtons_per_meter=400.0,
+            ),
+        )
+    return visualizer
+
+
+def _add_visuals(
+    builder, station: Station, scenario: Scenario, meshcat: Meshcat, outputs: dict
+) -> None:
+    """The pull's arrows, the CoM and its reference, the state and psi (visuals.py), at
+    the recording's rate."""
+    visuals = builder.AddNamedSystem(
+        "visuals",
+        StandupVisuals(
+            station.plant,
+            station.robot,
+            meshcat,
+            on_step_grid(scenario.visualization.publish_period_s, scenario.plant.time_step),
+            scenario.advancement.psi_dot_upper,
+        ),
+    )
+    sources: dict[str, OutputPort] = {
+        **outputs,
+        "hand_wrenches_W": outputs["applied_hand_wrenches_W"],
+    }
+    for i in range(visuals.num_input_ports()):
+        port = visuals.get_input_port(i)
+        builder.Connect(sources[port.get_name()], port)
+
+
+def on_step_grid(period_s: float, step_s: float) -> float:
+    """period_s rounded to a whole number (>= 1) of plant steps (step_s > 0: a discrete
+    plant, config.validate). A publish between the plant's steps splits an integrator
+    step of psi, so a recording would change the simulation it records; a run's chunk
+    end a rounding error off an event time makes the integrator take a ~1e-17 s step."""
+    return step_s * max(1, round(period_s / step_s))
+
+
+def add_seat_hold(builder, scene: Scene, scenario: Scenario, desired_state, actuation) -> None:
+    """Drake's implicit joint PD toward the seated pose (into the plant's desired_state
+    input, here the port desired_state) plus constant gravity feed-forward evaluated at
+    that pose (into actuation): the chair carries the base."""
+    plant = scene.plant
+    instance = scene.robot.model_instance
+    plant_context = plant.CreateDefaultContext()
+    set_seated_state(scene, plant_context, scenario)
+    q0 = plant.GetPositions(plant_context, instance)
+    u_ff = plant.MakeActuationMatrix().T @ (-plant.CalcGravityGeneralizedForces(plant_context))
+    q_index = actuated_joints(plant, instance).q_index
+    x0 = np.concatenate([q0[q_index], np.zeros(len(q_index))])
+    setpoint = builder.AddNamedSystem("seat_hold_setpoint", ConstantVectorSource(x0))
+    feedforward = builder.AddNamedSystem("seat_hold_feedforward", ConstantVectorSource(u_ff))
+    builder.Connect(setpoint.get_output_port(), desired_state)
+    builder.Connect(feedforward.get_output_port(), actuation)

@@ -1,0 +1,168 @@
+"""make_standup_controller(scenario, station): the stand-up controller, as one diagram.
+
+    state machine ──mode──► contact schedule ──commands──┬──► controller model ──terms──┐
+       │ state, segment, advances                        │   (weighs the robot seated)  │
+       ▼                                                 │                              ▼
+    advancement ◄──► CoM reference ──com_reference──► task references ──► whole-body controller
+                     (psi, x_d(psi))                                 commands ──┘  │ torques
+
+The state machine (state_machine.py) follows the phase table (phases.py); the
+advancement (advancement.py) integrates psi; the CoM reference (reference.py) is x_d(psi)
+and its derivatives; the contact schedule (control/schedule.py), the controller's model
+with its mass estimate (control/model.py, control/mass.py) and the task references
+(control/references.py) feed the whole-body QP (control/controller.py).
+
+Inputs (a station's outputs of the same names, station.py): robot_state, pad_forces_W,
+seat_pad_normal_forces_N, pads_vertical_force_N, hand_wrenches_W (measured), com_W,
+com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, standing_pull_usage; response (1: the
+response code, config.RESPONSES' index: which of the pull the advancement and the task
+references take, control/references.py); and stand_up (1; > 0.5: start; unconnected:
+never), which only the live helper has.
+Outputs: actuation; controller_diagnostics (control/controller.py: DIAGNOSTICS); psi,
+psi_dot, alpha; com_reference, x_d_W; standup_state, held_back, segment, entry_times_s;
+lean_W; compliance_W (the compliant response's offset and rate); mass_estimate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import partial
+
+from pydrake.systems.framework import Diagram, DiagramBuilder
+
+from drake_standup.config import Scenario
+from drake_standup.config.phases import resolve_com_heights
+from drake_standup.control.controller import WholeBodyController
+from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
+from drake_standup.control.qp import as_slice
+from drake_standup.standup.advancement import TrajectoryAdvancement
+from drake_standup.standup.com_path import CoMReferenceGenerator
+from drake_standup.standup.contact_schedule import ContactScheduler
+from drake_standup.standup.state_machine import StandupStateMachine
+from drake_standup.standup.task_references import (
+    ReferenceGenerator,
+    StandupSchedule,
+    TaskReferenceGenerator,
+)
+from drake_standup.world.scene import erect_com_height_m
+from drake_standup.world.sensing import standing_lean
+from drake_standup.world.station import Station
+
+# (system, its input) <- (system or "" for the diagram's own input, its output)
+_WIRES = [
+    ("state_machine", "psi", "advancement", "psi"),
+    ("state_machine", "com_W", "", "com_W"),
+    ("state_machine", "heel_x_W", "", "heel_x_W"),
+    ("state_machine", "thigh_x_W", "", "thigh_x_W"),
+    ("state_machine", "standing_pull_usage", "", "standing_pull_usage"),
+    ("state_machine", "pad_forces_W", "", "pad_forces_W"),
+    ("state_machine", "hand_wrenches_W", "", "hand_wrenches_W"),
+    ("state_machine", "stand_up", "", "stand_up"),
+    ("advancement", "com_W", "", "com_W"),
+    ("advancement", "com_velocity_W", "", "com_velocity_W"),
+    ("advancement", "omega_f_W", "", "omega_f_W"),
+    ("advancement", "x_d_W", "com_reference", "x_d_W"),
+    ("advancement", "path_tangent_W", "com_reference", "path_tangent_W"),
+    ("advancement", "path_progress", "com_reference", "path_progress"),
+    ("advancement", "advances", "state_machine", "advances"),
+    ("com_reference", "psi", "advancement", "psi"),
+    ("com_reference", "psi_dot", "advancement", "psi_dot"),
+    ("com_reference", "psi_ddot", "advancement", "psi_ddot"),
+    ("com_reference", "segment", "state_machine", "segment"),
+    ("contact_schedule", "mode", "state_machine", "mode"),
+    ("contact_schedule", "seat_pad_normal_forces_N", "", "seat_pad_normal_forces_N"),
+    ("contact_schedule", "commanded_normal_forces_N", "controller", "commanded_normal_forces_N"),
+    ("controller_model", "robot_state", "", "robot_state"),
+    ("controller_model", "pads_vertical_force_N", "", "pads_vertical_force_N"),
+    ("controller_model", "standup_state", "state_machine", "standup_state"),
+    ("controller_model", "contact_commands", "contact_schedule", "contact_commands"),
+    ("controller_model", "hand_wrenches_W", "", "hand_wrenches_W"),
+    ("task_references", "terms", "controller_model", "terms"),
+    ("task_references", "standup_state", "state_machine", "standup_state"),
+    ("task_references", "com_reference", "com_reference", "com_reference"),
+    ("task_references", "hand_wrenches_W", "", "hand_wrenches_W"),
+    ("task_references", "path_progress", "com_reference", "path_progress"),
+    ("task_references", "response", "", "response"),
+    ("advancement", "response", "", "response"),
+    ("controller", "terms", "controller_model", "terms"),
+    ("controller", "task_references", "task_references", "task_references"),
+    ("controller", "contact_commands", "contact_schedule", "contact_commands"),
+]
+# The diagram's outputs: name -> (system, its output).
+_OUTPUTS = {
+    "actuation": ("controller", "actuation"),
+    "controller_diagnostics": ("controller", "diagnostics"),
+    "psi": ("advancement", "psi"),
+    "psi_dot": ("advancement", "psi_dot"),
+    "alpha": ("advancement", "alpha"),
+    "com_reference": ("com_reference", "com_reference"),
+    "x_d_W": ("com_reference", "x_d_W"),
+    "standup_state": ("state_machine", "standup_state"),
+    "held_back": ("state_machine", "held_back"),
+    "segment": ("state_machine", "segment"),
+    "entry_times_s": ("state_machine", "entry_times_s"),
+    "lean_W": ("task_references", "lean_W"),
+    "compliance_W": ("task_references", "compliance_W"),
+    "mass_estimate": ("controller_model", "mass_estimate"),
+}
+
+
+@dataclass
+class StandupController:
+    diagram: Diagram
+    controller: WholeBodyController  # for its compute times (bench.py)
+
+
+def make_standup_controller(scenario: Scenario, station: Station) -> StandupController:
+    """The diagram of the module docstring for the station's robot."""
+    plant, robot = station.plant, station.robot
+    config, period_s = scenario.controller, scenario.controller_period_s
+    # Each robot stands at its own erect height (phases.Phase.com_height_erect).
+    table = resolve_com_heights(
+        scenario.phases, lambda posture: erect_com_height_m(station.scene, scenario, posture)
+    )
+    g = -plant.gravity_field().gravity_vector()[2]
+    specs = contact_specs(plant, robot, config)
+    joints = ControllerJoints.of(plant, robot)
+    schedule = StandupSchedule(table, config, joints.names, joints.q_min, joints.q_max)
+    systems = {
+        "state_machine": StandupStateMachine(
+            scenario.standup, table, len(station.pad_groups), station.sole_rows()
+        ),
+        "advancement": TrajectoryAdvancement(scenario.advancement),
+        "com_reference": CoMReferenceGenerator(),
+        "contact_schedule": ContactScheduler(config, table, period_s),
+        "controller_model": ControllerModel(plant, robot, specs, config, period_s),
+        "task_references": TaskReferenceGenerator(
+            ReferenceGenerator(
+                config,
+                schedule,
+                as_slice(joints.q_indices),
+                period_s,
+                g,
+                scenario.compliance,
+                partial(standing_lean, support=station.standing),
+                scenario.standup.standing_pull_usage_limit,
+            ),
+            period_s,
+        ),
+        "controller": WholeBodyController(plant, specs, joints, config, table, period_s),
+    }
+    builder = DiagramBuilder()
+    for name, system in systems.items():
+        builder.AddNamedSystem(name, system)
+    exported: set[str] = set()
+    for system, port, source, output in _WIRES:
+        destination = systems[system].GetInputPort(port)
+        if source:
+            builder.Connect(systems[source].GetOutputPort(output), destination)
+        elif output in exported:
+            builder.ConnectInput(output, destination)
+        else:
+            builder.ExportInput(destination, output)
+            exported.add(output)
+    for name, (system, port) in _OUTPUTS.items():
+        builder.ExportOutput(systems[system].GetOutputPort(port), name)
+    diagram = builder.Build()
+    diagram.set_name("standup_controller")
+    return StandupController(diagram, systems["controller"])

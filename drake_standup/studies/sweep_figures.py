@@ -1,0 +1,96 @@
+"""A sweep's figures, drawn from its run records as its sweep file asks (sweep_file.Figure):
+line (mean of a metric per parameter value, one line per group) or rate (a metric's rate
+per bin of a parameter)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from drake_standup.studies.sweep_file import Figure
+from drake_standup.studies.sweep_table import finite_number, table_rows
+
+
+def _order(value):
+    """Sorts numbers numerically and before anything else."""
+    return (0, value, "") if isinstance(value, (int, float)) else (1, 0, str(value))
+
+
+def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
+    """line: mean y per x value (one line per group; runs that did not stand
+    up drawn as crosses on the x axis); rate: mean of y (e.g. success) per x bin,
+    with the number of runs per bin."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = table_rows(records)
+    if not rows or fig.x not in rows[0]:
+        return None
+    fig_obj, ax = plt.subplots(figsize=(6.4, 4.2))
+    if fig.kind == "line":
+        groups = sorted({row.get(fig.group) for row in rows}, key=_order) if fig.group else [None]
+        markers = "osD^v<>p"
+        for k, g in enumerate(groups):
+            sel = [r for r in rows if fig.group is None or r.get(fig.group) == g]
+            xs = sorted({r[fig.x] for r in sel}, key=_order)
+            stood = [(r[fig.x], finite_number(r.get(fig.y))) for r in sel if r.get("success")]
+            mean = [
+                np.mean([y for x, y in stood if x == at and y is not None] or [np.nan]) for at in xs
+            ]
+            label = f"{fig.group} = {g}" if fig.group else None
+            (line,) = ax.plot(xs, mean, marker=markers[k % len(markers)], label=label)
+            # Failed runs: a cross at their value, or on the x axis without one.
+            failed = [
+                (r[fig.x], finite_number(r.get(fig.y)) or 0.0) for r in sel if not r.get("success")
+            ]
+            if failed:
+                ax.plot(*zip(*failed), "x", color=line.get_color(), ms=10, mew=2)
+        if fig.group:
+            ax.legend(fontsize=8)
+        ax.set_ylabel(fig.y)
+        ax.text(
+            0.01,
+            0.01,
+            "lines: mean over runs that stood up; x: a run that failed, at its value or,\n"
+            "without one, on the x axis (reason in results.csv)",
+            transform=ax.transAxes,
+            fontsize=7,
+        )
+    else:
+        xs = np.array([r[fig.x] for r in rows], dtype=float)
+        ys = np.array([float(bool(r.get(fig.y))) for r in rows])
+        low, high = fig.range or (xs.min(), xs.max())
+        edges = np.linspace(low, high, fig.bins + 1)
+        which = np.clip(np.digitize(xs, edges[1:-1]), 0, fig.bins - 1)
+        counts = np.bincount(which, minlength=fig.bins)
+        filled = counts > 0  # empty bins get no bar
+        rates = np.bincount(which, weights=ys, minlength=fig.bins)[filled] / counts[filled]
+        centres = (0.5 * (edges[:-1] + edges[1:]))[filled]
+        width = 0.9 * (edges[1] - edges[0])
+        ax.bar(centres, rates, width=width, color="tab:blue", alpha=0.7, edgecolor="tab:blue")
+        for c, r, n in zip(centres, rates, counts[filled]):
+            ax.text(c, r + 0.02, f"n={n}", ha="center", fontsize=8)
+        ax.set_ylim(0, 1.15)
+        ax.set_ylabel(f"{fig.y} rate")
+    for k, line in enumerate(fig.lines):
+        ax.axvline(line["x"], color="tab:red", ls="--", lw=1.2)
+        ax.text(
+            line["x"],
+            0.98 - 0.07 * k,
+            f" {line['label']}",
+            transform=ax.get_xaxis_transform(),
+            color="tab:red",
+            fontsize=8,
+            va="top",
+        )
+    ax.set_xlabel(fig.x)
+    ax.set_title(fig.title or f"{fig.y} vs {fig.x}", fontsize=10)
+    ax.grid(alpha=0.3)
+    fig_obj.tight_layout()
+    path = out_dir / f"{fig.y}_vs_{fig.x}.png".replace("/", "_")
+    fig_obj.savefig(path, dpi=110)
+    plt.close(fig_obj)
+    return path

@@ -1,0 +1,144 @@
+"""The world of the stand-up: a discrete MultibodyPlant with the iCub, a chair
+and a floor, hydroelastic contact, and the robot's seated initial state."""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, SceneGraph
+from pydrake.math import RigidTransform, RollPitchYaw
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.systems.framework import Context, DiagramBuilder
+
+from drake_standup.config import Scenario, chair_file
+from drake_standup.config.inputs import add_sdf
+from drake_standup.config.resources import model_file
+from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
+from drake_standup.world.perturbations import scale_friction
+
+
+class _NoDeformableHalfSpaceWarning(logging.Filter):
+    """Drake warns, for every rigid half-space, that deformable bodies cannot
+    touch it; the scene has no deformable bodies, so the warning says nothing."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return "half spaces are not currently supported for deformable" not in record.getMessage()
+
+
+logging.getLogger("drake").addFilter(_NoDeformableHalfSpaceWarning())
+
+
+@dataclass
+class Scene:
+    plant: MultibodyPlant
+    scene_graph: SceneGraph
+    robot: Robot
+
+
+def add_scene(
+    builder: DiagramBuilder,
+    scenario: Scenario,
+    *,
+    pd_gains: tuple[float, float] | None = None,
+    visuals: bool = True,
+) -> Scene:
+    """Adds plant and scene graph to builder; returns the finalized scene."""
+    plant, scene_graph = AddMultibodyPlant(scenario.plant, builder)
+    robot = add_icub(
+        plant,
+        scenario.robot.model,
+        reduce=scenario.robot.reduced,
+        visuals=visuals,
+        effort_limit_Nm=scenario.robot.effort_limit_Nm,
+        pd_gains=pd_gains,
+        visual_max_faces=scenario.robot.visual_max_faces,
+        motor_inertia=reflects_motor_inertia(
+            scenario.robot.reflected_inertia, scenario.robot.model
+        ),
+    )
+    parser = Parser(plant)
+    (floor,) = add_sdf(parser, model_file("floor.sdf"))
+    # One model with a frame 'chair' (config.validate parsed it so).
+    (chair,) = add_sdf(parser, chair_file(scenario.chair.file))
+    world = plant.world_frame()
+    plant.WeldFrames(world, plant.GetFrameByName("floor", floor))
+    plant.WeldFrames(
+        world,
+        plant.GetFrameByName("chair", chair),
+        RigidTransform(scenario.chair.xyz_m),
+    )
+    plant.Finalize()
+    # Model error of perturbation.friction_scale: every surface, in the model.
+    scale_friction(plant, scene_graph, scenario.perturbation.friction_scale)
+
+    # The robot touches the world only through its pads; pads never touch each
+    # other (self-collision is not part of this task).
+    robot_geometries = GeometrySet(list(robot.contact_geometries.values()))
+    scene_graph.collision_filter_manager().Apply(
+        CollisionFilterDeclaration().ExcludeWithin(robot_geometries)
+    )
+    return Scene(plant, scene_graph, robot)
+
+
+def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -> None:
+    """Puts the robot in the scenario's seated pose, at rest (config.validate checked the
+    joints' names)."""
+    plant = scene.plant
+    instance = scene.robot.model_instance
+    init = scenario.initial
+    set_joint_positions(plant, plant_context, instance, init.joints_rad)
+    root = plant.GetBodyByName("root_link", instance)
+    plant.SetFreeBodyPose(
+        plant_context,
+        root,
+        RigidTransform(RollPitchYaw(init.base_rpy_rad), init.base_xyz_m),
+    )
+    plant.SetVelocities(plant_context, instance, 0.0 * plant.GetVelocities(plant_context, instance))
+
+
+def _standing_context(scene: Scene, scenario: Scenario, posture_rad: dict[str, float]):
+    """A plant context of the robot in a standing posture: the joints named in
+    posture_rad at their values (the others as seated), the base upright at the seated
+    yaw, 1 m up; and the soles' heights when seated."""
+    plant = scene.plant
+    instance = scene.robot.model_instance
+    context = plant.CreateDefaultContext()
+    set_seated_state(scene, context, scenario)
+    soles = [scene.robot.frame(plant, name) for name in ("l_sole", "r_sole")]
+    sole_z_seated = [frame.CalcPoseInWorld(context).translation()[2] for frame in soles]
+    set_joint_positions(plant, context, instance, posture_rad)
+    root = plant.GetBodyByName("root_link", instance)
+    yaw = scenario.initial.base_rpy_rad[2]
+    plant.SetFreeBodyPose(context, root, RigidTransform(RollPitchYaw(0.0, 0.0, yaw), [0, 0, 1]))
+    return context, soles, sole_z_seated
+
+
+def erect_com_height_m(scene: Scene, scenario: Scenario, posture_rad: dict[str, float]) -> float:
+    """The CoM's height above the floor in a standing posture (_standing_context), the
+    soles at the height they rest at on the floor when seated. With the sagittal
+    leg angles summing to zero (hip pitch + knee + ankle pitch, as in the authors' state-4
+    posture) the soles are then flat on the floor (checked by the caller's tests)."""
+    plant = scene.plant
+    context, soles, sole_z_seated = _standing_context(scene, scenario, posture_rad)
+    sole_z = [frame.CalcPoseInWorld(context).translation()[2] for frame in soles]
+    com_z = plant.CalcCenterOfMassPositionInWorld(context, [scene.robot.model_instance])[2]
+    return float(com_z - min(sole_z) + min(sole_z_seated))
+
+
+def standing_offsets_m(
+    scene: Scene, scenario: Scenario, posture_rad: dict[str, float]
+) -> tuple[np.ndarray, np.ndarray]:
+    """In a standing posture (_standing_context): the hands' origins from the CoM (2 x 3,
+    left, right) and the soles' origins from it (2 x 3), world axes, m."""
+    plant = scene.plant
+    context, soles, _ = _standing_context(scene, scenario, posture_rad)
+    com = plant.CalcCenterOfMassPositionInWorld(context, [scene.robot.model_instance])
+
+    def offsets(names):
+        frames = [scene.robot.frame(plant, name) for name in names]
+        return np.array([f.CalcPoseInWorld(context).translation() - com for f in frames])
+
+    return offsets(("l_hand", "r_hand")), offsets(("l_sole", "r_sole"))

@@ -1,0 +1,163 @@
+"""make_station(scenario): the world the stand-up controller acts in, as one diagram.
+
+The plant with the iCub, the chair and the floor (scene.py), the contact forces on the
+robot's pads (contacts.py) and the leg force sensors made of them, what the robot senses
+of itself (sensing.py: CoM, Omega f, the heels), the hands' force/torque sensors (noisy
+with perturbation.hand_wrench_noise_N) and the pushes of the perturbations (the shape of
+RussTedrake/manipulation's MakeHardwareStation: a diagram with named exported ports).
+
+Inputs
+    actuation                 (nu) joint torques, actuator order, N m
+    hand_spatial_forces       the hands' pull on the robot (abstract, human.py)
+    applied_hand_wrenches_W   (12) the same pull as wrenches, what the hands' sensors read
+    desired_state             (2 nu) only with pd_gains (the seat-hold benchmark)
+Outputs
+    robot_state, net_actuation, contact_results, query_object
+    pad_forces_W              (3 per pad) the contact force on each pad, world
+    seat_pad_normal_forces_N  (3) normal force on the buttocks, left and right thigh pads
+    pads_vertical_force_N     (1) the vertical force on all the robot's pads
+    hand_wrenches_W           (12) the hands' sensors' wrenches (payloads.HAND_WRENCHES)
+    com_W, com_velocity_W, omega_f_W, heel_x_W, thigh_x_W   sensing.py
+    hand_positions_W, hand_velocities_W   (6 each) where the hands are pulled, m, m/s
+    standing_pull_usage       (1) the share of the standing feet's hold a pull needs
+    push_force_W              (3) only with perturbation.pushes
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.multibody.plant import ExternallyAppliedSpatialForceMultiplexer, MultibodyPlant
+from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import MatrixGain, PassThrough
+
+from drake_standup.config import Scenario
+from drake_standup.ports.payloads import HAND_WRENCHES
+from drake_standup.robot.icub import ActuatedJoints, Robot, actuated_joints
+from drake_standup.world.pad_forces import ContactForceReporter
+from drake_standup.world.perturbations import NoisyWrenchSensor, PushSource
+from drake_standup.world.scene import Scene, add_scene, erect_com_height_m, standing_offsets_m
+from drake_standup.world.sensing import RobotSensing, StandingSupport, heel_points, thigh_points
+
+# Pad groups as metrics.json reports them (plural where there are two).
+_GROUP_LABELS = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
+# The pads under the seat pads of the contact schedule (control/schedule.py), in order.
+SEAT_PAD_FRAMES = ("buttocks", "l_thigh", "r_thigh")
+
+
+@dataclass
+class Station:
+    """The station's diagram and what its users build on: the plant (the controller's
+    model, the human's and the visuals' kinematics), the robot's handles, its pads."""
+
+    diagram: Diagram
+    scene: Scene
+    pad_groups: dict[str, str]  # pad geometry name -> group, in pad_forces_W's order
+    joints: ActuatedJoints
+    standing: StandingSupport  # what the standing robot's feet can hold (sensing.py)
+
+    @property
+    def plant(self) -> MultibodyPlant:
+        return self.scene.plant
+
+    @property
+    def robot(self) -> Robot:
+        return self.scene.robot
+
+    def sole_rows(self) -> tuple[int, int]:
+        """The rows of the left and right soles' pads in pad_forces_W."""
+        names = list(self.pad_groups)
+        return tuple(
+            names.index(shape.name)
+            for frame in ("l_sole", "r_sole")
+            for shape in self.robot.contact_shapes
+            if shape.frame == frame
+        )
+
+
+def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None) -> Station:
+    """The station of the module docstring; pd_gains: Drake's joint PD on every actuator
+    (the seat-hold benchmark), with the desired_state input."""
+    builder = DiagramBuilder()
+    scene = add_scene(builder, scenario, pd_gains=pd_gains)
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    pad_groups = {
+        name: _GROUP_LABELS.get(group, group)
+        for group, names in robot.contact_groups.items()
+        for name in names
+    }
+    pads = list(pad_groups)
+    reporter = builder.AddNamedSystem(
+        "contact_forces", ContactForceReporter(pads, [robot.contact_geometries[n] for n in pads])
+    )
+    builder.Connect(plant.get_contact_results_output_port(), reporter.get_input_port())
+    # Leg force sensors: the seat pads' normal forces, and the vertical force on all pads
+    # (the robot's weight while it sits still).
+    by_frame = {shape.frame: shape.name for shape in robot.contact_shapes}
+    seat = np.zeros((len(SEAT_PAD_FRAMES), 3 * len(pads)))
+    for row, task in enumerate(SEAT_PAD_FRAMES):
+        seat[row, 3 * pads.index(by_frame[robot.TASK_FRAMES[task]]) + 2] = 1.0
+    total = np.zeros((1, 3 * len(pads)))
+    total[0, 2::3] = 1.0
+    gains = {"seat_pad_normal_forces_N": seat, "pads_vertical_force_N": total}
+    for name, gain in gains.items():
+        system = builder.AddNamedSystem(name, MatrixGain(gain))
+        builder.Connect(reporter.get_output_port(), system.get_input_port())
+        builder.ExportOutput(system.get_output_port(), name)
+
+    pert = scenario.perturbation
+    if pert.pushes:
+        pushes = builder.AddNamedSystem("pushes", PushSource(plant, robot, pert.pushes))
+        mux = builder.AddNamedSystem("applied_forces", ExternallyAppliedSpatialForceMultiplexer(2))
+        builder.ExportInput(mux.get_input_port(0), "hand_spatial_forces")
+        builder.Connect(pushes.GetOutputPort("spatial_forces"), mux.get_input_port(1))
+        builder.Connect(mux.get_output_port(), plant.get_applied_spatial_force_input_port())
+        builder.ExportOutput(pushes.GetOutputPort("push_force_W"), "push_force_W")
+    else:
+        builder.ExportInput(plant.get_applied_spatial_force_input_port(), "hand_spatial_forces")
+    if pert.hand_wrench_noise_N > 0.0:
+        sensor = NoisyWrenchSensor(
+            pert.hand_wrench_noise_N, pert.hand_wrench_noise_period_s, pert.noise_seed
+        )
+    else:
+        sensor = PassThrough(HAND_WRENCHES.size)
+    sensor = builder.AddNamedSystem("hand_wrench_sensor", sensor)
+    builder.ExportInput(sensor.get_input_port(), "applied_hand_wrenches_W")
+    measured = sensor.get_output_port()
+    builder.ExportOutput(measured, "hand_wrenches_W")
+
+    rise, config = scenario.phases.rise, scenario.controller
+    hands, soles = standing_offsets_m(scene, scenario, rise.posture_rad)
+    standing = StandingSupport(
+        com_height_m=rise.com_height_m or erect_com_height_m(scene, scenario, rise.posture_rad),
+        hands_m=hands,
+        soles_m=soles,
+        lean_m=(config.lean_max_forward_m, config.lean_max_back_m, config.lean_max_m),
+        cop_x_m=tuple(config.foot_cop_x_m),
+        cop_y_m=tuple(config.foot_cop_y_m),
+    )
+    sensing = builder.AddNamedSystem(
+        "sensing",
+        RobotSensing(plant, robot, heel_points(robot), thigh_points(robot), standing),
+    )
+    robot_state = plant.get_state_output_port(instance)
+    builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
+    builder.Connect(measured, sensing.GetInputPort("hand_wrenches_W"))
+    for name in ("com_W", "com_velocity_W", "omega_f_W", "heel_x_W", "thigh_x_W"):
+        builder.ExportOutput(sensing.GetOutputPort(name), name)
+    for name in ("standing_pull_usage", "hand_positions_W", "hand_velocities_W"):
+        builder.ExportOutput(sensing.GetOutputPort(name), name)
+
+    builder.ExportInput(plant.get_actuation_input_port(instance), "actuation")
+    if pd_gains is not None:
+        builder.ExportInput(plant.get_desired_state_input_port(instance), "desired_state")
+    builder.ExportOutput(robot_state, "robot_state")
+    builder.ExportOutput(plant.get_net_actuation_output_port(instance), "net_actuation")
+    builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
+    builder.ExportOutput(scene.scene_graph.get_query_output_port(), "query_object")
+    builder.ExportOutput(reporter.get_output_port(), "pad_forces_W")
+    diagram = builder.Build()
+    diagram.set_name("station")
+    return Station(diagram, scene, pad_groups, actuated_joints(plant, instance), standing)
