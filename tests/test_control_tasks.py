@@ -13,9 +13,10 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
 from drake_standup.control.model import contact_specs
-from drake_standup.control.qp import ContactCommands, ContactMap, QpLayout, Task, WholeBodyQp
+from drake_standup.control.qp import ContactMap, QpContactBounds, QpLayout, Task, WholeBodyQp
+from drake_standup.control.targets import TaskReferences
 from drake_standup.control.terms import RobotKinematics, RobotTerms
-from drake_standup.standup.task_references import TaskReferences, static_lean
+from drake_standup.robot.balance import static_lean
 from drake_standup.world.scene import add_scene, set_seated_state
 
 TARGET_RAD_PER_S2 = 2.0
@@ -110,6 +111,7 @@ def _qp(plant, specs, task_states, **bounds):
         wrench_weight=config.wrench_weight,
         acceleration_weight=config.acceleration_weight,
         tasks=tasks,
+        modes=(1, 2, 3, 4),
         **bounds,
     )
 
@@ -120,7 +122,7 @@ def test_a_new_task_acts_only_in_its_active_states(seated):
     solution is the one of the QP without the task."""
     plant, specs, terms, k = seated
     nc = len(specs)
-    commands = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    commands = QpContactBounds(np.full(nc, 10.0), np.full(nc, 1000.0), {})
     with_task = _qp(plant, specs, (k, (2,)))
     without = _qp(plant, specs, None)
     for standup_state in (1, 2, 3):
@@ -166,7 +168,7 @@ def test_static_lean_is_bounded_and_zero_without_a_pull():
 def test_soft_bounds_that_hold_at_the_optimum_change_nothing(seated):
     plant, specs, terms, k = seated
     nc = len(specs)
-    commands = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    commands = QpContactBounds(np.full(nc, 10.0), np.full(nc, 1000.0), {})
     free = _qp(plant, specs, (k, (2,))).solve(terms, _references(2), commands)
     loose = _FixedBounds([k], [-100.0], [100.0])
     bounded = _qp(plant, specs, (k, (2,)), soft_bounds=loose, soft_bound_weight=1e3).solve(
@@ -185,7 +187,7 @@ def test_soft_bound_against_a_task_meets_it_where_the_weights_say(weight):
     analytic optimum (to the regularisation's 1e-6 relative)."""
     plant, specs, terms, k = seated_state()
     nc = len(specs)
-    commands = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    commands = QpContactBounds(np.full(nc, 10.0), np.full(nc, 1000.0), {})
     bounds = _FixedBounds([k], [-100.0], [-1.0])
     solution = _qp(plant, specs, (k, (2,)), soft_bounds=bounds, soft_bound_weight=weight).solve(
         terms, _references(2), commands
@@ -204,7 +206,7 @@ def test_soft_bounds_keep_an_impossible_bound_feasible(seated):
     plant, specs, terms, _ = seated
     nc = len(specs)
     knee = plant.GetJointByName("l_knee").velocity_start()
-    commands = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    commands = QpContactBounds(np.full(nc, 10.0), np.full(nc, 1000.0), {})
     impossible = _FixedBounds([knee], [5.0], [100.0])
     hard = _qp(plant, specs, None, acceleration_bounds=impossible)
     # As a hard bound: infeasible with the contacts held; only the relaxed fallback (the
@@ -224,7 +226,7 @@ def test_an_infeasible_program_falls_back_to_the_relaxed_one(seated):
     dynamics' base rows still exact and the torques within their limits."""
     plant, specs, terms, _ = seated
     nc = len(specs)
-    impossible = ContactCommands(np.full(nc, 1000.0), np.full(nc, 2000.0), {})
+    impossible = QpContactBounds(np.full(nc, 1000.0), np.full(nc, 2000.0), {})
     solution = _qp(plant, specs, None).solve(terms, _references(2), impossible)
     assert solution.ok and solution.relaxed
     assert np.abs(solution.tau).max() <= EFFORT_LIMIT_NM + 1e-6
@@ -234,5 +236,5 @@ def test_an_infeasible_program_falls_back_to_the_relaxed_one(seated):
     residual = terms.M[:6] @ solution.vdot + terms.h[:6] - generalized[:6]
     np.testing.assert_allclose(residual, 0.0, atol=1e-6)
     # A feasible program is not relaxed.
-    fine = ContactCommands(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    fine = QpContactBounds(np.full(nc, 10.0), np.full(nc, 1000.0), {})
     assert not _qp(plant, specs, None).solve(terms, _references(2), fine).relaxed

@@ -21,11 +21,12 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
 from drake_standup.config.phases import PhaseTable
+from drake_standup.control.contacts import CONTACTS
 from drake_standup.control.controller import DIAGNOSTICS, WholeBodyController
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
 from drake_standup.control.terms import RobotKinematics
-from drake_standup.standup.contact_schedule import CONTACTS, contact_commands, phase_seat_hold
+from drake_standup.standup.contact_schedule import contact_commands, phase_seat_hold
 from drake_standup.standup.state_machine import initial_mode
 from drake_standup.standup.task_references import (
     ReferenceGenerator,

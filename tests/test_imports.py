@@ -1,4 +1,4 @@
-"""Imports run one way: no cycle among the package's modules, counting every import
+"""Imports run one way, and the package stays readable: no cycle among the package's modules, counting every import
 statement anywhere in a file (in functions and under `if TYPE_CHECKING:` too) and every
 importlib.import_module("drake_standup...") of a literal name."""
 
@@ -110,24 +110,105 @@ def test_the_check_sees_every_kind_of_import(tmp_path, monkeypatch):
     assert _cycles(_graph()) == [["drake_standup.a", "drake_standup.b", "drake_standup.sub.c"]]
 
 
+# The package's layers, lowest first: a module imports only from its own layer or lower
+# ones (docs/design.md, "The house"). The top-level modules (cli, __main__) sit above all.
+LAYERS = (
+    "ports",
+    "config",
+    "robot",
+    "world",
+    "control",
+    "standup",
+    "outputs",
+    "sim",
+    "studies",
+)
+TOP_LEVEL_LIMIT = 12  # modules at the package's top, __init__ included
+MODULE_LINE_LIMIT = 450
+FUNCTION_LINE_LIMIT = 80
+
+
+def _layer(module: str) -> int:
+    """module's layer index; the package's own top-level modules are above every layer."""
+    parts = module.split(".")
+    if len(parts) > 1 and parts[1] in LAYERS:
+        return LAYERS.index(parts[1])
+    if len(parts) > 2 or (len(parts) == 2 and (PACKAGE / parts[1]).is_dir()):
+        raise AssertionError(f"{module}: in no layer of LAYERS")
+    return len(LAYERS)
+
+
+def _upward_imports(graph: dict[str, set[str]]) -> list[tuple[str, str]]:
+    return sorted(
+        (module, target)
+        for module, targets in graph.items()
+        for target in targets
+        if _layer(target) > _layer(module)
+    )
+
+
+def test_every_sub_package_is_a_layer():
+    packages = {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").exists()}
+    assert packages == set(LAYERS)
+
+
+def test_layers_import_downward_only():
+    """For every pair of layers, the lower one reaches nothing of the higher one."""
+    assert _upward_imports(_graph()) == []
+
+
 @pytest.mark.parametrize(
     "low, high",
-    [
-        ("drake_standup.config", "drake_standup.sim.diagram"),
-        ("drake_standup.config.phases", "drake_standup.standup.state_machine"),
-        ("drake_standup.control.controller", "drake_standup.sim.runner"),
-        ("drake_standup.sim.runner", "drake_standup.sim.live"),
-        ("drake_standup.config.arguments", "drake_standup.cli"),
-    ],
+    [(low, high) for i, low in enumerate(LAYERS) for high in LAYERS[i + 1 :]],
 )
-def test_layers_import_downward_only(low, high):
-    """Data flows config -> model -> systems -> diagram -> runner -> entry points: a lower
-    layer reaches no higher one, directly or through others."""
+def test_no_layer_reaches_a_higher_one_through_others(low, high):
+    """Transitively too: nothing in low reaches high through a chain of imports."""
     graph = _graph()
-    reached, todo = set(), [low]
+    todo = [m for m in graph if _layer(m) == LAYERS.index(low)]
+    reached = set(todo)
     while todo:
         for module in graph[todo.pop()]:
             if module not in reached:
                 reached.add(module)
                 todo.append(module)
-    assert high not in reached
+    assert not [m for m in reached if _layer(m) == LAYERS.index(high)]
+
+
+def test_the_layer_check_finds_an_upward_import():
+    graph = {
+        "drake_standup.config.a": {"drake_standup.sim.b"},
+        "drake_standup.sim.b": {"drake_standup.config.a"},
+    }
+    assert _upward_imports(graph) == [("drake_standup.config.a", "drake_standup.sim.b")]
+
+
+def test_the_package_top_holds_few_modules():
+    assert len(list(PACKAGE.glob("*.py"))) <= TOP_LEVEL_LIMIT
+
+
+def _long_functions(path: Path) -> list[str]:
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            lines = node.end_lineno - node.lineno + 1
+            if lines > FUNCTION_LINE_LIMIT:
+                found.append(f"{path.name}:{node.name} {lines}")
+    return found
+
+
+def test_no_module_or_function_is_too_long():
+    modules = _modules().values()
+    long_modules = [
+        f"{p.relative_to(PACKAGE)} {n}"
+        for p in modules
+        if (n := len(p.read_text().splitlines())) > MODULE_LINE_LIMIT
+    ]
+    long_functions = [f for p in modules for f in _long_functions(p)]
+    assert (long_modules, long_functions) == ([], [])
+
+
+def test_the_length_check_counts_a_long_function(tmp_path):
+    path = tmp_path / "m.py"
+    body = "\n".join(f"    x{i} = {i}" for i in range(FUNCTION_LINE_LIMIT))
+    path.write_text(f"def f():\n{body}\n")
+    assert _long_functions(path) == [f"m.py:f {FUNCTION_LINE_LIMIT + 1}"]

@@ -76,3 +76,23 @@ def wrench_cone_matrix(spec: ContactSpec) -> np.ndarray:
             [-1.0, 0.0, 0.0, 0.0, 0.0, y_min],
         ]
     )
+
+
+# The controller's contacts: the seat pads (state_machine.SEAT_LOADS' order) and soles.
+CONTACTS = ("seat", "l_thigh", "r_thigh", "l_sole", "r_sole")
+CHAIR = slice(0, 3)
+SOLES = slice(3, 5)
+HOLDS = ("held", "hinged", "free")
+THIGH_HOLDS = ("free", "normal", "flat")
+
+
+@dataclass(frozen=True)
+class ContactCommands:
+    """What the QP may ask of each contact this tick, in CONTACTS' order."""
+
+    active: tuple[bool, ...]  # the contact is in the QP
+    min_normal_force_N: np.ndarray  # (5,) f_z bounds, N
+    max_normal_force_N: np.ndarray  # (5,)
+    seat_hold: str  # HOLDS: the seat's rows held (all, all but the hip pitch, none)
+    # The thighs' rows held: none (free), their normal (normal) or their pitch too (flat).
+    thighs_hold: str = "free"

@@ -32,10 +32,18 @@ from pydrake.systems.framework import BasicVector, Context, DiscreteValues, Leaf
 
 from drake_standup.config import ControllerConfig
 from drake_standup.config.phases import PhaseTable
-from drake_standup.control.contacts import NORMAL, WRENCH_SIZE, ContactSpec
+from drake_standup.control.contacts import (
+    CONTACTS,
+    HOLDS,
+    NORMAL,
+    THIGH_HOLDS,
+    WRENCH_SIZE,
+    ContactCommands,
+    ContactSpec,
+)
 from drake_standup.control.model import ControllerJoints
-from drake_standup.control.qp import ContactCommands as QpContactCommands
-from drake_standup.control.qp import ContactMap, QpSolution, WholeBodyQp
+from drake_standup.control.qp import ContactMap, QpContactBounds, QpSolution, WholeBodyQp
+from drake_standup.control.targets import joint_values
 from drake_standup.control.tasks import (
     BaseOrientationTask,
     CopCenteringTask,
@@ -45,8 +53,6 @@ from drake_standup.control.tasks import (
     StancePostureTask,
 )
 from drake_standup.ports.payloads import VectorLayout
-from drake_standup.standup.contact_schedule import CONTACTS, HOLDS, THIGH_HOLDS, ContactCommands
-from drake_standup.standup.task_references import joint_values
 
 DIAGNOSTICS = VectorLayout(
     ("qp_ok", 1),  # 1 if this tick's QP succeeded, else 0 (torques held)
@@ -81,6 +87,7 @@ def make_program(
     config: ControllerConfig,
     stance_states: set[int],
     torque_limit_Nm: float,
+    modes: tuple[int, ...],
 ) -> Program:
     """The QP over the active contacts with the controller's tasks (control/tasks.py):
     momentum, CoP centering, posture; in the stance states the legs' posture and the
@@ -143,6 +150,7 @@ def make_program(
         wrench_weight=config.wrench_weight,
         acceleration_weight=config.acceleration_weight,
         tasks=tasks,
+        modes=modes,
         soft_bounds=JointLimitBounds(
             joints.q_indices,
             joints.v_indices,
@@ -214,12 +222,13 @@ class WholeBodyController(LeafSystem):
             plant.get_joint_actuator(i).effort_limit() for i in actuators
         )
         stance = {k for k, phase in enumerate(table, start=1) if phase.stance}
+        modes = tuple(k for k, _ in enumerate(table, start=1))
         self._make = lambda active: make_program(
-            specs, active, plant, joints, config, stance, torque_limit
+            specs, active, plant, joints, config, stance, torque_limit, modes
         )
         self._programs: dict[tuple[bool, ...], Program] = {}
         # The last contact commands and the program's form of them.
-        self._last: tuple[ContactCommands | None, QpContactCommands | None] = (None, None)
+        self._last: tuple[ContactCommands | None, QpContactBounds | None] = (None, None)
         self._timing: list[tuple[float, ...]] = []
         self._terms = self.DeclareAbstractInputPort("terms", Value[object](None))
         self._references = self.DeclareAbstractInputPort("task_references", Value[object](None))
@@ -266,7 +275,7 @@ class WholeBodyController(LeafSystem):
         if commands is not self._last[0]:  # the schedule's constant commands repeat
             self._last = (
                 commands,
-                QpContactCommands(
+                QpContactBounds(
                     commands.min_normal_force_N[index],
                     commands.max_normal_force_N[index],
                     program.partially_held[(commands.seat_hold, commands.thighs_hold)],

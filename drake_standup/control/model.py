@@ -18,13 +18,12 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import BasicVector, Context, DiscreteValues, LeafSystem
 
 from drake_standup.config import ControllerConfig
-from drake_standup.control.contacts import ContactSpec
+from drake_standup.control.contacts import CONTACTS, ContactCommands, ContactSpec
 from drake_standup.control.mass import next_mass_state
 from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.ports.caching import declare_cached
 from drake_standup.ports.payloads import HAND_WRENCHES
 from drake_standup.robot.icub import Robot, actuated_joints
-from drake_standup.standup.contact_schedule import CONTACTS, ContactCommands
 
 HANDS = ("l_hand", "r_hand")
 _F_Z_LEFT = HAND_WRENCHES["f_l"].start + 2

@@ -50,8 +50,8 @@ import numpy as np
 
 from drake_standup.control.backends import make_backend
 from drake_standup.control.contacts import WRENCH_SIZE, ContactSpec, wrench_cone_matrix
+from drake_standup.control.targets import TaskReferences
 from drake_standup.control.terms import RobotTerms
-from drake_standup.standup.task_references import STATES, TaskReferences
 
 N_BASE = 6  # unactuated floating-base velocities
 
@@ -80,7 +80,7 @@ class QpLayout:
 
 class Task:
     """One least-squares objective, w ||A z[columns] - b||^2 (w: weight, a scalar or one
-    weight per row of A), in the standup states active_states (control/tasks.py).
+    weight per row of A), in the modes active_states (None: every mode; control/tasks.py).
 
     A task sets weight, columns, A and b when it is made and refreshes what changes in
     update(), each tick it is active. constant_A: A never changes, so the QP adds w A^T A
@@ -91,7 +91,7 @@ class Task:
     columns: slice
     A: np.ndarray  # (rows, width of columns)
     b: np.ndarray  # (rows,)
-    active_states: frozenset[int] = frozenset(STATES)
+    active_states: frozenset[int] | None = None
     constant_A: bool = False
     constant_b: bool = False
 
@@ -110,7 +110,7 @@ class AccelerationBounds(Protocol):
 
 
 @dataclass
-class ContactCommands:
+class QpContactBounds:
     """What the contact plan asks of the program's contacts this tick (in its order)."""
 
     min_normal_force_N: np.ndarray  # (nc,)
@@ -216,6 +216,7 @@ class WholeBodyQp:
         wrench_weight: float,
         acceleration_weight: float,
         tasks: list[Task],
+        modes: tuple[int, ...],
         acceleration_bounds: AccelerationBounds | None = None,
         soft_bounds: AccelerationBounds | None = None,
         soft_bound_weight: float = 0.0,
@@ -223,9 +224,11 @@ class WholeBodyQp:
         contact_velocity_gain_per_s: float = 0.0,
     ):
         """contact_map: the active contacts and their map (the tasks may share it).
-        tasks: the cost's tasks. acceleration_bounds: bounds on entries of vdot, computed
-        each tick (None: none). soft_bounds: bounds that a slack s per entry may move,
-        vdot_min <= vdot - s <= vdot_max, at the cost soft_bound_weight s^2 (at the
+        tasks: the cost's tasks. modes: the values references.standup_state takes
+        (each task is active in its active_states of them). acceleration_bounds: bounds on
+        entries of vdot, computed each tick (None: none). soft_bounds: bounds that a slack
+        s per entry may move, vdot_min <= vdot - s <= vdot_max, at the cost
+        soft_bound_weight s^2 (at the
         optimum |s| is the violation; one two-sided row per entry, the slacks last in z,
         after the layout's unknowns): the program stays feasible whatever the state."""
         nv, nu = B.shape
@@ -289,7 +292,7 @@ class WholeBodyQp:
         self._screen_cache: dict[tuple[bytes, int], tuple[np.ndarray, ...]] = {}
         self.screening_resolves = 0  # ticks that had to solve again (a joint broke in)
         # The constrained contacts' rows are equalities (all rows held) until solve() gets
-        # ContactCommands.partially_held: the last one it got.
+        # QpContactBounds.partially_held: the last one it got.
         self._equality[self._bounds(rows_acc)] = 1
         self._partially_held: dict[int, np.ndarray] = {}
         # Rows of A that the last partially_held leaves free (None: all held).
@@ -324,11 +327,13 @@ class WholeBodyQp:
             )
         )
         self.tasks = list(tasks)
-        # standup state -> its _ActiveTasks (states with the same active tasks share one).
+        # mode -> its _ActiveTasks (modes with the same active tasks share one).
         by_flags: dict[tuple[bool, ...], _ActiveTasks] = {}
         self._active_tasks: dict[int, _ActiveTasks] = {}
-        for state in STATES:
-            flags = tuple(state in task.active_states for task in self.tasks)
+        for state in modes:
+            flags = tuple(
+                task.active_states is None or state in task.active_states for task in self.tasks
+            )
             if flags not in by_flags:
                 by_flags[flags] = self._precompute(
                     [task for task, on in zip(self.tasks, flags, strict=True) if on]
@@ -448,7 +453,7 @@ class WholeBodyQp:
         self,
         terms: RobotTerms,
         references: TaskReferences,
-        commands: ContactCommands,
+        commands: QpContactBounds,
     ) -> QpSolution:
         """Solves the tick's QP.
 

@@ -21,8 +21,8 @@ import numpy as np
 from drake_standup.control.contacts import ContactSpec
 from drake_standup.control.qp import ContactMap, QpLayout, Task, as_slice
 from drake_standup.control.spatial import cross, rotation_vector, skew
+from drake_standup.control.targets import TaskReferences
 from drake_standup.control.terms import RobotTerms
-from drake_standup.standup.task_references import TaskReferences
 
 
 class MomentumTask(Task):

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 
 from drake_standup.config import RESPONSES
+from drake_standup.control.contacts import CONTACTS
 from drake_standup.control.controller import DIAGNOSTICS
 from drake_standup.ports.payloads import COM_REFERENCE, SEGMENT
-from drake_standup.standup.contact_schedule import CONTACTS
 from drake_standup.world.human import HELPER_SPENT
 
 # Version of signals.npz's layout; bump it (and keep load_signals reading the

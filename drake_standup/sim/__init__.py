@@ -1,1 +1,2 @@
-"""Building and running the diagram: the diagram, the runner, simulate, the psi = t baseline, the live mode and the Meshcat visuals."""
+"""Building and running the diagram: the diagram, the runner, simulate, the psi = t
+baseline, the run's folder, the live mode and the Meshcat visuals."""

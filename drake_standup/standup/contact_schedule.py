@@ -25,7 +25,6 @@ the seat holds no rows once the buttocks release: docs/design.md, "Contacts".
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from pydrake.common.value import Value
@@ -33,27 +32,9 @@ from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
 from drake_standup.config import ControllerConfig
 from drake_standup.config.phases import PhaseTable
+from drake_standup.control.contacts import CHAIR, CONTACTS, HOLDS, SOLES, ContactCommands
 from drake_standup.ports.caching import declare_cached
 from drake_standup.standup.state_machine import StandupMode, seat_loads, seat_releases
-
-# The controller's contacts: the seat pads (state_machine.SEAT_LOADS' order) and soles.
-CONTACTS = ("seat", "l_thigh", "r_thigh", "l_sole", "r_sole")
-CHAIR = slice(0, 3)
-SOLES = slice(3, 5)
-HOLDS = ("held", "hinged", "free")
-THIGH_HOLDS = ("free", "normal", "flat")
-
-
-@dataclass(frozen=True)
-class ContactCommands:
-    """What the QP may ask of each contact this tick, in CONTACTS' order."""
-
-    active: tuple[bool, ...]  # the contact is in the QP
-    min_normal_force_N: np.ndarray  # (5,) f_z bounds, N
-    max_normal_force_N: np.ndarray  # (5,)
-    seat_hold: str  # HOLDS: the seat's rows held (all, all but the hip pitch, none)
-    # The thighs' rows held: none (free), their normal (normal) or their pitch too (flat).
-    thighs_hold: str = "free"
 
 
 def next_unload_from(

@@ -48,7 +48,6 @@ The posture reference and the base's target orientation:
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.value import Value
@@ -57,12 +56,13 @@ from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 from drake_standup.config import RESPONSES, ComplianceConfig, ControllerConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.control.spatial import yaw_pitch_rotation
+from drake_standup.control.targets import StateReferences, TaskReferences, joint_values
 from drake_standup.control.terms import RobotTerms
 from drake_standup.ports.caching import declare_cached
 from drake_standup.ports.payloads import COM_REFERENCE, HAND_WRENCHES
+from drake_standup.robot.balance import static_lean
 from drake_standup.standup.com_path import smoothstep
 
-STATES = (1, 2, 3, 4)
 # The response codes (the index in config.RESPONSES) the controller's systems read.
 ADVANCEMENT, STIFF, COMPLIANT = (RESPONSES.index(name) for name in RESPONSES)
 
@@ -103,32 +103,6 @@ def helpful_force(
     return fade * max(float(f_hand_W @ u), 0.0) * u
 
 
-def joint_values(
-    names: list[str], table: dict[str, float], key: str, default: float = math.nan
-) -> np.ndarray:
-    """table (joint name -> value) in the order of names, default where a joint is not
-    named; an unknown name is an error that names the config field key."""
-    unknown = sorted(set(table) - set(names))
-    if unknown:
-        raise ValueError(f"controller.{key}: unknown joint(s) {', '.join(unknown)}")
-    return np.array([table.get(name, default) for name in names])
-
-
-@dataclass(frozen=True)
-class StateReferences:
-    """What one standup state asks of the tasks and the seat."""
-
-    com_kp_per_s2: np.ndarray  # K_P (x, y, z), 1/s^2
-    com_kd_per_s: np.ndarray  # K_D = 2 zeta sqrt(K_P), 1/s
-    # Posture target, actuator order, clamped inside the joint limits; NaN where hold.
-    posture_rad: np.ndarray
-    posture_hold: np.ndarray  # True: the joint holds the first tick's posture
-    base_pitch_rad: float  # forward pitch of the base target
-    seat_hinged: bool  # the seat leaves the pelvis' pitch about the hip axis free
-    lean: bool  # the CoM target leans against the pull (the feet alone carry the robot)
-    stance: bool  # the legs' posture, not the CoM height, ends the segment (state 4)
-
-
 class StandupSchedule:
     """StateReferences of states 1-4 from the phase table (phases.py)."""
 
@@ -160,57 +134,6 @@ class StandupSchedule:
 
     def __getitem__(self, standup_state: int) -> StateReferences:
         return self._by_state[standup_state]
-
-
-@dataclass(slots=True)
-class TaskReferences:
-    """One tick's references, computed upstream of the QP: what Task.update reads."""
-
-    standup_state: int
-    state: StateReferences
-    Ldot_star: np.ndarray  # (6,) [Ldot_ang*; m xddot* + f_par], N m / N
-    tau_hand: np.ndarray | None  # J_h^T F_hand, both hands (None: no pull)
-    q_reference: np.ndarray  # (nu,) filtered posture reference, rad
-    R_WB_target: np.ndarray  # (3, 3) base target orientation
-    helpful_force_W: np.ndarray  # f_par, N (zero: no pull)
-    lean_W: np.ndarray  # (3,) the CoM target's lean against the pull this tick, m
-    # The momentum task's vertical row weight, a fraction of its weight (state 4's end).
-    vertical_weight_scale: float
-    # How far the legs have taken over the end of the rise, 0-1 (state 4).
-    stance: float
-    next_height_integral: float  # the stance's CoM height integral after this tick, m s
-    # int L_ang dt after this tick (+ T L_ang of this tick's state), N m s^2.
-    next_momentum_integral: np.ndarray
-    # The posture state after this tick: [latched flag, first tick's posture (nu),
-    # q_ref's next value (nu), first tick's base yaw].
-    next_posture: np.ndarray
-    # The admittance's [offset (3), rate (3)] after this tick (response compliant), m, m/s.
-    next_compliance: np.ndarray = field(default_factory=lambda: np.zeros(6))
-
-
-def static_lean(
-    hand_wrench_Com: np.ndarray, com_height_m: float, weight_N: float, max_lean_m: float
-) -> np.ndarray:
-    """(3,) CoM shift (x, y; z = 0) that keeps the feet's centre of pressure where it is
-    without the pull, in static balance.
-
-    hand_wrench_Com = [tau; f], the hands' resultant about the CoM (W, N m / N). With the
-    CoM at height h above the soles and the ground reaction R = -(f + m g) acting at the
-    CoP p, the moments about the CoM balance when
-
-        p_x - c_x = (tau_y + h f_x) / (m g - f_z),   p_y - c_y = -(tau_x - h f_y) / (m g - f_z):
-
-    so the CoM moves by -(tau_y + h f_x) / (m g - f_z) in x and (tau_x - h f_y) / (m g - f_z)
-    in y for the CoP to stay put. Clipped to max_lean_m (each axis); zero if the pull
-    would lift the robot."""
-    tau, f = hand_wrench_Com[:3], hand_wrench_Com[3:]
-    support = weight_N - f[2]
-    if support <= 0.0:
-        return np.zeros(3)
-    lean = np.array(
-        [-(tau[1] + com_height_m * f[0]) / support, (tau[0] - com_height_m * f[1]) / support, 0.0]
-    )
-    return np.clip(lean, -max_lean_m, max_lean_m)
 
 
 class ReferenceGenerator:

@@ -15,8 +15,8 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
 from drake_standup.ports.caching import declare_cached
+from drake_standup.robot.balance import static_lean
 from drake_standup.robot.icub import Robot
-from drake_standup.standup.task_references import static_lean
 from drake_standup.world.human import TASK_FRAMES
 
 
