@@ -176,10 +176,14 @@ def test_controller_period_on_the_plant_grid_is_accepted(tmp_path, time_step, pe
     assert (scenario.plant.time_step, scenario.controller_period_s) == (time_step, period)
 
 
-def test_the_readme_scenario_example_parses():
-    """The README's list of public keys is a valid scenario (keeps the README true)."""
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    example = text[text.index("## Scenarios") :].split("```yaml\n", 1)[1].split("```", 1)[0]
+@pytest.mark.parametrize(
+    "document, section", [("README.md", "## Scenarios"), ("docs/outputs.md", "## Scenario files")]
+)
+def test_the_documented_scenario_examples_parse(document, section):
+    """The README's keys and docs/outputs.md's full list are valid scenarios (keeps both
+    true)."""
+    text = (Path(__file__).resolve().parents[1] / document).read_text()
+    example = text[text.index(section) :].split("```yaml\n", 1)[1].split("```", 1)[0]
     scenario = parse_scenario(example)
     assert scenario.phases.rise.com_height_erect and scenario.phases.rise.com_height_m is None
     assert scenario.phases.forward.unload_when == 0.015
