@@ -349,6 +349,22 @@ BAD = {
         "perturbation.pushes[0].body: 'spine' unknown; accepted: the bodies of "
         "iCubGazeboV2_5 reduced: {bodies}",
     ),
+    # A run count no sweep means, refused from the sizes before any run is expanded
+    # (tests/test_sweep.py times it); the total counts the grid's combinations too.
+    "sweep_too_many_samples": (
+        {"many.yaml": "base: assisted\nsamples: 100000000\n"},
+        ["sweep", "many.yaml"],
+        "samples: 100000000; accepted: an integer from 1 to 10000 (runs in one sweep)",
+    ),
+    "sweep_grid_times_samples_too_many_runs": (
+        {
+            "many.yaml": "base: assisted\nsamples: 2000\ngrid:\n"
+            "  advancement.psi_dot_upper: [1.5, 2.5]\n  fall.min_root_height_m: [0.1, 0.2, 0.3]\n"
+        },
+        ["sweep", "many.yaml"],
+        "grid x samples: 2 advancement.psi_dot_upper x 3 fall.min_root_height_m x 2000 samples "
+        "= 12000 runs; accepted: at most 10000 runs in one sweep",
+    ),
     # 6. The comparison of responses (drake-standup compare).
     "compare_unknown_helper": (
         {},
@@ -378,6 +394,7 @@ IN_A_FRESH_PROCESS = [
     "model_iCubGenova03",
     "unknown_seat_hinge_joint",
     "compare_run_beyond_the_sweep",
+    "sweep_too_many_samples",
 ]
 
 
