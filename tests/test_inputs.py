@@ -296,6 +296,40 @@ BAD = {
         )
         for name, missing in LACKING.items()
     },
+    # A rise no robot makes: a CoM height above the model's own CoM standing straight (in
+    # the phase's arms, scene.check_com_heights, checked as the station is built, before
+    # the first step), or not above the floor (config.rules).
+    "rise_com_height_unreachable": (
+        {},
+        [*RUN, "--set", "phases.rise.com_height_m=5.0"],
+        "phases.rise.com_height_m: 5.0; accepted: a number > 0 and <= 0.601 (m: "
+        "iCubGazeboV2_5's CoM standing straight, 0.581, + 0.02)",
+    ),
+    # The bound is the model's: 0.59 m is within iCubGazeboV2_5's reach, not iCubGenova01's.
+    "rise_com_height_beyond_this_model": (
+        {},
+        [
+            *RUN,
+            "--scenario",
+            "unassisted",
+            "--set",
+            "robot.model=iCubGenova01",
+            "--set",
+            "phases.rise.com_height_m=0.59",
+        ],
+        "phases.rise.com_height_m: 0.59; accepted: a number > 0 and <= 0.579 (m: "
+        "iCubGenova01's CoM standing straight, 0.559, + 0.02)",
+    ),
+    "rise_com_height_zero": (
+        {},
+        [*RUN, "--set", "phases.rise.com_height_m=0"],
+        "phases.rise.com_height_m: 0.0; accepted: a number > 0",
+    ),
+    "rise_com_height_negative": (
+        {},
+        [*RUN, "--set", "phases.rise.com_height_m=-0.5"],
+        "phases.rise.com_height_m: -0.5; accepted: a number > 0",
+    ),
     # 7. Joint and body names the model does not have.
     "unknown_initial_joint": (
         {},
@@ -395,6 +429,7 @@ IN_A_FRESH_PROCESS = [
     "unknown_seat_hinge_joint",
     "compare_run_beyond_the_sweep",
     "sweep_too_many_samples",
+    "rise_com_height_unreachable",
 ]
 
 
