@@ -135,12 +135,18 @@ def run_main(argv: list[str] | None = None, prog: str = "drake-standup run") -> 
 
     from drake_standup.sim.simulate import simulate
 
-    if args.live:
-        from drake_standup.sim.live import run_live
+    # The checks that need the robot's geometry (scene.check_com_heights) run as the
+    # station is built, before the first step: the same one line and exit code 2.
+    try:
+        if args.live:
+            from drake_standup.sim.live import run_live
 
-        result = run_live(scenario, args.out, args.duration)
-    else:
-        result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
+            result = run_live(scenario, args.out, args.duration)
+        else:
+            result = simulate(scenario, args.out, record=not args.no_recording, baseline=True)
+    except ScenarioError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
     m = result.metrics
     for name, path in result.files.items():
         print(f"wrote {name}: {path}")

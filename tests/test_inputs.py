@@ -296,6 +296,40 @@ BAD = {
         )
         for name, missing in LACKING.items()
     },
+    # A rise no robot makes: a CoM height above the model's own CoM standing straight (in
+    # the phase's arms, scene.check_com_heights, checked as the station is built, before
+    # the first step), or not above the floor (config.rules).
+    "rise_com_height_unreachable": (
+        {},
+        [*RUN, "--set", "phases.rise.com_height_m=5.0"],
+        "phases.rise.com_height_m: 5.0; accepted: a number > 0 and <= 0.601 (m: "
+        "iCubGazeboV2_5's CoM standing straight, 0.581, + 0.02)",
+    ),
+    # The bound is the model's: 0.59 m is within iCubGazeboV2_5's reach, not iCubGenova01's.
+    "rise_com_height_beyond_this_model": (
+        {},
+        [
+            *RUN,
+            "--scenario",
+            "unassisted",
+            "--set",
+            "robot.model=iCubGenova01",
+            "--set",
+            "phases.rise.com_height_m=0.59",
+        ],
+        "phases.rise.com_height_m: 0.59; accepted: a number > 0 and <= 0.579 (m: "
+        "iCubGenova01's CoM standing straight, 0.559, + 0.02)",
+    ),
+    "rise_com_height_zero": (
+        {},
+        [*RUN, "--set", "phases.rise.com_height_m=0"],
+        "phases.rise.com_height_m: 0.0; accepted: a number > 0",
+    ),
+    "rise_com_height_negative": (
+        {},
+        [*RUN, "--set", "phases.rise.com_height_m=-0.5"],
+        "phases.rise.com_height_m: -0.5; accepted: a number > 0",
+    ),
     # 7. Joint and body names the model does not have.
     "unknown_initial_joint": (
         {},
@@ -349,6 +383,22 @@ BAD = {
         "perturbation.pushes[0].body: 'spine' unknown; accepted: the bodies of "
         "iCubGazeboV2_5 reduced: {bodies}",
     ),
+    # A run count no sweep means, refused from the sizes before any run is expanded
+    # (tests/test_sweep.py times it); the total counts the grid's combinations too.
+    "sweep_too_many_samples": (
+        {"many.yaml": "base: assisted\nsamples: 100000000\n"},
+        ["sweep", "many.yaml"],
+        "samples: 100000000; accepted: an integer from 1 to 10000 (runs in one sweep)",
+    ),
+    "sweep_grid_times_samples_too_many_runs": (
+        {
+            "many.yaml": "base: assisted\nsamples: 2000\ngrid:\n"
+            "  advancement.psi_dot_upper: [1.5, 2.5]\n  fall.min_root_height_m: [0.1, 0.2, 0.3]\n"
+        },
+        ["sweep", "many.yaml"],
+        "grid x samples: 2 advancement.psi_dot_upper x 3 fall.min_root_height_m x 2000 samples "
+        "= 12000 runs; accepted: at most 10000 runs in one sweep",
+    ),
     # 6. The comparison of responses (drake-standup compare).
     "compare_unknown_helper": (
         {},
@@ -378,6 +428,8 @@ IN_A_FRESH_PROCESS = [
     "model_iCubGenova03",
     "unknown_seat_hinge_joint",
     "compare_run_beyond_the_sweep",
+    "sweep_too_many_samples",
+    "rise_com_height_unreachable",
 ]
 
 

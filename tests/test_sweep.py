@@ -8,6 +8,7 @@ import socket
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,13 @@ import pytest
 
 from drake_standup.config import SCENARIO_DIR, apply_overrides, load_scenario
 from drake_standup.studies.sweep import main, run_one, run_sweep
-from drake_standup.studies.sweep_file import SweepError, expand, load_sweep
+from drake_standup.studies.sweep_file import (
+    MAX_RUNS,
+    SweepError,
+    check_run_count,
+    expand,
+    load_sweep,
+)
 from drake_standup.studies.sweep_table import read_table, simulation_rows
 
 
@@ -202,6 +209,64 @@ def test_cli_bad_input_is_one_error_line_and_exit_2(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and all(line.startswith("error: ") for line in err)
     assert "missing.yaml' not found" in err[0] and "--workers: 0" in err[1]
+
+
+@pytest.mark.parametrize(
+    "text, field",
+    [
+        # Expanded, 10^12 runs would take years (each run is checked, ~0.1 s) or exhaust
+        # the memory; 100^10 grid combinations likewise.
+        ("base: assisted\nsamples: 1000000000000\n", "samples: 1000000000000; accepted"),
+        # Each factor within the bound, their product not: 20,000 runs, half an hour to
+        # expand.
+        (
+            "base: assisted\nsamples: 10000\ngrid: {advancement.psi_dot_upper: [1.5, 2.5]}\n",
+            "grid x samples: 2 advancement.psi_dot_upper x 10000 samples = 20000 runs",
+        ),
+        (
+            "base: assisted\ngrid:\n"
+            + "".join(
+                f"  - {{name: p{i}, path: advancement.psi_dot_upper, values: {[1.5] * 100}}}\n"
+                for i in range(10)
+            ),
+            "grid x samples: 100 p0 x 100 p1",
+        ),
+    ],
+    ids=["samples", "samples_and_grid", "grid"],
+)
+def test_a_run_count_no_sweep_means_is_refused_at_once(tmp_path, text, field):
+    """Through `python -m drake_standup sweep` in a fresh process: exit 2 and one error
+    line naming the field, within seconds: refused from the sizes, before expansion (which
+    would outlast the timeout, or the memory)."""
+    path = _write(tmp_path, text)
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent)}
+    t0 = time.perf_counter()
+    done = subprocess.run(
+        [sys.executable, "-m", "drake_standup", "sweep", str(path), "--out", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+        check=False,
+    )
+    elapsed = time.perf_counter() - t0
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {field}"), lines
+    assert str(MAX_RUNS) in lines[0]
+    assert elapsed < 30.0  # the process's imports included; the check itself is immediate
+    assert not (tmp_path / "o").exists()
+
+
+def test_the_run_count_bound_counts_grid_times_samples(tmp_path):
+    spec = load_sweep(_write(tmp_path, GRID))  # 3 x 2 grid combinations
+    assert check_run_count(spec) == 6
+    most = MAX_RUNS // 6
+    assert check_run_count(replace(spec, samples=most)) == 6 * most
+    with pytest.raises(SweepError, match=f"= {6 * (most + 1)} runs; accepted: at most"):
+        check_run_count(replace(spec, samples=most + 1))
+    with pytest.raises(SweepError, match=f"samples: {MAX_RUNS + 1}; accepted"):
+        check_run_count(replace(spec, samples=MAX_RUNS + 1, grid=[]))
 
 
 # Four short runs, one of which fails at once: its fall bound is above the

@@ -88,6 +88,9 @@ PERTURBATION_KEYS = ("push", "mass_scale", "friction_scale", "hand_wrench_noise_
 PUSH_DEFAULTS = {"body": Push.body, "start_s": Push.start_s, "duration_s": Push.duration_s}
 PUSH_DEFAULTS.update(magnitude_N=0.0, azimuth_deg=0.0, elevation_deg=0.0)
 DRAWS = "{uniform: [low, high]}, {normal: [mean, std]} or {choice: [a, b, ...]}"
+# Runs a sweep file may expand to: a run costs ~10 s, so 10,000 are ~28 CPU-hours (14 h on
+# two workers); past that a count is a slip, and expanding it (~0.1 s a run) would hang.
+MAX_RUNS = 10_000
 
 
 def load_sweep(path: str | Path) -> SweepSpec:
@@ -259,10 +262,30 @@ def run_key(base_text: str, overrides: list) -> str:
     return hashlib.sha1(payload.encode()).hexdigest()[:12]
 
 
+def check_run_count(spec: SweepSpec) -> int:
+    """The number of runs spec expands to (grid combinations x samples), from the sizes
+    alone; raises SweepError past MAX_RUNS."""
+    sizes = [len(p.values) for p in spec.grid]
+    total = math.prod(sizes) * spec.samples
+    if spec.samples > MAX_RUNS:
+        raise SweepError(
+            f"samples: {spec.samples}; accepted: an integer from 1 to {MAX_RUNS} "
+            f"(runs in one sweep)"
+        )
+    if total > MAX_RUNS:
+        factors = " x ".join(f"{n} {p.name}" for n, p in zip(sizes, spec.grid, strict=True))
+        raise SweepError(
+            f"grid x samples: {factors} x {spec.samples} samples = {total} runs; accepted: "
+            f"at most {MAX_RUNS} runs in one sweep"
+        )
+    return total
+
+
 def expand(spec: SweepSpec) -> list[RunSpec]:
     """Grid x samples runs; run k's draws come from the generator seeded by
     (seed, k), so a run's parameters don't depend on the others. Checks every
     key path and value against the base scenario (raises SweepError)."""
+    check_run_count(spec)  # first: nothing expanded or allocated yet
     base = _checked("base", parse_scenario, spec.base_text, str(spec.base_path))
     fixed = [
         (concrete, value)

@@ -13,8 +13,9 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.systems.framework import Context, DiagramBuilder
 
-from drake_standup.config import Scenario, chair_file
+from drake_standup.config import Scenario, ScenarioError, chair_file
 from drake_standup.config.inputs import add_sdf
+from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
 from drake_standup.world.perturbations import scale_friction
@@ -126,6 +127,46 @@ def erect_com_height_m(scene: Scene, scenario: Scenario, posture_rad: dict[str, 
     sole_z = [frame.CalcPoseInWorld(context).translation()[2] for frame in soles]
     com_z = plant.CalcCenterOfMassPositionInWorld(context, [scene.robot.model_instance])[2]
     return float(com_z - min(sole_z) + min(sole_z_seated))
+
+
+# The joints standing_com_height_m straightens (those the model has): legs and torso.
+_STRAIGHT = [f"{s}_{j}" for s in "lr" for j in ("hip_pitch", "hip_roll", "hip_yaw", "knee")]
+_STRAIGHT += [f"{s}_{j}" for s in "lr" for j in ("ankle_pitch", "ankle_roll")]
+_STRAIGHT += ["torso_pitch", "torso_roll", "torso_yaw"]
+# How far above the model's straight standing CoM a phase's com_height_m may end: the arms
+# raised higher than the posture's and the soles' rest height, well under 1 cm each. m.
+COM_HEIGHT_MARGIN_M = 0.02
+
+
+def standing_straight_com_height_m(
+    scene: Scene, scenario: Scenario, posture_rad: dict[str, float]
+) -> float:
+    """The highest the CoM stands with the soles flat on the floor: erect_com_height_m of
+    posture_rad with the legs and the torso straight (their joints at 0), the arms as
+    posture_rad has them."""
+    instance = scene.robot.model_instance
+    straight = {n: 0.0 for n in _STRAIGHT if scene.plant.HasJointNamed(n, instance)}
+    return erect_com_height_m(scene, scenario, {**posture_rad, **straight})
+
+
+def check_com_heights(scene: Scene, scenario: Scenario) -> None:
+    """Each phase's com_height_m within the robot's reach: at most its CoM standing
+    straight (standing_straight_com_height_m of the phase's posture) + COM_HEIGHT_MARGIN_M;
+    raises ScenarioError (one line). config.validate, which builds no plant, has checked
+    that it is > 0."""
+    model = scenario.robot.model
+    for name in PHASES:
+        phase = getattr(scenario.phases, name)
+        if phase.com_height_m is None:
+            continue
+        straight = standing_straight_com_height_m(scene, scenario, phase.posture_rad)
+        top = round(straight + COM_HEIGHT_MARGIN_M, 3)
+        if not 0.0 < phase.com_height_m <= top:
+            raise ScenarioError(
+                f"phases.{name}.com_height_m: {phase.com_height_m}; accepted: a number > 0 "
+                f"and <= {top} (m: {model}'s CoM standing straight, {straight:.3f}, "
+                f"+ {COM_HEIGHT_MARGIN_M})"
+            )
 
 
 def standing_offsets_m(

@@ -37,7 +37,13 @@ from drake_standup.ports.payloads import HAND_WRENCHES
 from drake_standup.robot.icub import ActuatedJoints, Robot, actuated_joints
 from drake_standup.world.pad_forces import ContactForceReporter
 from drake_standup.world.perturbations import NoisyWrenchSensor, PushSource
-from drake_standup.world.scene import Scene, add_scene, erect_com_height_m, standing_offsets_m
+from drake_standup.world.scene import (
+    Scene,
+    add_scene,
+    check_com_heights,
+    erect_com_height_m,
+    standing_offsets_m,
+)
 from drake_standup.world.sensing import RobotSensing, StandingSupport, heel_points, thigh_points
 
 # Pad groups as metrics.json reports them (plural where there are two).
@@ -81,6 +87,8 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
     (the seat-hold benchmark), with the desired_state input."""
     builder = DiagramBuilder()
     scene = add_scene(builder, scenario, pd_gains=pd_gains)
+    # The first check that needs the robot's geometry, before anything simulates.
+    check_com_heights(scene, scenario)
     plant, robot = scene.plant, scene.robot
     instance = robot.model_instance
     pad_groups = {
