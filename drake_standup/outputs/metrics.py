@@ -7,7 +7,6 @@ import numpy as np
 
 from drake_standup.outputs.signals import group_normal_forces
 from drake_standup.world.human import HELPER_SPENT
-from drake_standup.world.scene import erect_com_height_m
 
 
 def seated_metrics(signals: dict[str, np.ndarray], weight_N: float, settle_s: float = 0.5) -> dict:
@@ -83,7 +82,7 @@ def standup_metrics(
         return metrics
     if standing_height_m is None:
         done = signals["psi"] - signals["segment_psi_entry"] >= signals["segment_psi_length"]
-        if not (signals["state"][-1] == 4 and done[-1]):
+        if not (signals["state"][-1] == len(entry_times_s) and done[-1]):
             return metrics
         height = float(signals["com_reference_W"][-1, 2])
     else:
@@ -168,6 +167,7 @@ def run_metrics(
     scenario,
     psi_final: float | None,
     entry_times_s: tuple[float, ...],
+    standing_height_m: float | None = None,
 ) -> dict:
     """metrics.json's entries of a run from its signals: the seated balance and the final
     contact forces, the robot's mass (the model's, and the simulated one with
@@ -185,9 +185,10 @@ def run_metrics(
     samples = len(signals["time_s"])
     if psi_final is not None:
         metrics.update(advancement_metrics(psi_final, signals["psi_dot"], entry_times_s))
-        height = erect_com_height_m(station.scene, scenario, scenario.phases.rise.posture_rad)
         metrics.update(
-            standup_metrics(signals, metrics["state_entry_times_s"], standing_height_m=height)
+            standup_metrics(
+                signals, metrics["state_entry_times_s"], standing_height_m=standing_height_m
+            )
         )
         metrics["qp_failures"] = int(signals["qp_failures"][-1]) if samples else 0
     if samples and "qp_ok" in signals:

@@ -19,6 +19,7 @@ from drake_standup.config import RESPONSES, Scenario, validate
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.robot.icub import actuated_joints
 from drake_standup.sim.visuals import StandupVisuals
+from drake_standup.standup.plan import StandupPlan, make_plan
 from drake_standup.standup.standup_controller import make_standup_controller
 from drake_standup.world.human import HelperWork, HumanWrenchSource
 from drake_standup.world.scene import Scene, set_seated_state
@@ -63,6 +64,7 @@ class StandupDiagram:
     controller: WholeBodyController | None  # for its compute times (bench.py)
     logs: dict[str, VectorLogSink]  # output name -> logger
     visualizer: MeshcatVisualizer | None
+    plan: StandupPlan  # the phase table resolved for this robot and scene (standup/plan.py)
 
     def output(self, name: str, root_context) -> np.ndarray:
         """The diagram's output name in the root context."""
@@ -92,6 +94,7 @@ def build_diagram(
     station = make_station(
         scenario, (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad) if seat_hold else None
     )
+    plan = make_plan(scenario, station.scene)
     builder = DiagramBuilder()
     world = builder.AddNamedSystem("station", station.diagram)
     human = builder.AddNamedSystem(
@@ -123,7 +126,7 @@ def build_diagram(
             world.GetInputPort("actuation"),
         )
     else:
-        standup = make_standup_controller(scenario, station)
+        standup = make_standup_controller(scenario, station, plan)
         brain = builder.AddNamedSystem("standup_controller", standup.diagram)
         # The robot's response to the pull: the scenario's, or the live helper's switch.
         if human.HasOutputPort("response"):
@@ -151,11 +154,11 @@ def build_diagram(
     if meshcat is not None:
         visualizer = _add_meshcat(builder, world, scenario, meshcat)
         if standup is not None:
-            _add_visuals(builder, station, scenario, meshcat, outputs)
+            _add_visuals(builder, station, scenario, meshcat, outputs, plan.n_states)
     diagram = builder.Build()
     diagram.set_name("standup")
     return StandupDiagram(
-        diagram, station, None if standup is None else standup.controller, logs, visualizer
+        diagram, station, None if standup is None else standup.controller, logs, visualizer, plan
     )
 
 
@@ -185,7 +188,7 @@ def _add_meshcat(builder, world, scenario: Scenario, meshcat: Meshcat) -> Meshca
 
 
 def _add_visuals(
-    builder, station: Station, scenario: Scenario, meshcat: Meshcat, outputs: dict
+    builder, station: Station, scenario: Scenario, meshcat: Meshcat, outputs: dict, n_states: int
 ) -> None:
     """The pull's arrows, the CoM and its reference, the state and psi (visuals.py), at
     the recording's rate."""
@@ -197,6 +200,7 @@ def _add_visuals(
             meshcat,
             on_step_grid(scenario.visualization.publish_period_s, scenario.plant.time_step),
             scenario.advancement.psi_dot_upper,
+            n_states,
         ),
     )
     sources: dict[str, OutputPort] = {

@@ -216,6 +216,7 @@ def collect(run: Run) -> RunResult:
         scenario=scenario,
         psi_final=float(built.output("psi", root)[0]) if "psi" in built.logs else None,
         entry_times_s=tuple(built.output("entry_times_s", root)) if built.controller else (),
+        standing_height_m=built.plan.erect_com_height_m,
     )
     reason = run.failure_reason
     if reason is None and built.controller is not None:

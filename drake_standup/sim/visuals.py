@@ -72,7 +72,7 @@ def arrow_pose(p_W: np.ndarray, f_W: np.ndarray) -> RigidTransform:
 class StandupVisuals(LeafSystem):
     """Inputs robot_state ([q; v] of the robot), hand_wrenches_W (12: the
     helper's pull), com_W, x_d_W (3), standup_state, psi, psi_dot (1) and
-    entry_times_s (4: the state machine's). No outputs: it publishes to meshcat
+    entry_times_s (n_states: the state machine's). No outputs: it publishes to meshcat
     every period_s."""
 
     def __init__(
@@ -82,6 +82,7 @@ class StandupVisuals(LeafSystem):
         meshcat: Meshcat,
         period_s: float,
         psi_dot_upper: float,
+        n_states: int,
     ):
         super().__init__()
         self._meshcat = meshcat
@@ -98,7 +99,7 @@ class StandupVisuals(LeafSystem):
         self._standup_state = self.DeclareVectorInputPort("standup_state", 1)
         self._psi = self.DeclareVectorInputPort("psi", 1)
         self._psi_dot = self.DeclareVectorInputPort("psi_dot", 1)
-        self._entry = self.DeclareVectorInputPort("entry_times_s", 4)
+        self._entry = self.DeclareVectorInputPort("entry_times_s", n_states)
         self._add_objects(psi_dot_upper)
         self.DeclareInitializationPublishEvent(self._Publish)
         self.DeclarePeriodicPublishEvent(period_s, 0.0, self._Publish)

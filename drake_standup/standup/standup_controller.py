@@ -1,4 +1,4 @@
-"""make_standup_controller(scenario, station): the stand-up controller, as one diagram.
+"""make_standup_controller(scenario, station, plan): the stand-up controller, as one diagram.
 
     state machine ──mode──► contact schedule ──commands──┬──► controller model ──terms──┐
        │ state, segment, advances                        │   (weighs the robot seated)  │
@@ -7,10 +7,10 @@
                      (psi, x_d(psi))                                 commands ──┘  │ torques
 
 The state machine (state_machine.py) follows the phase table (phases.py); the
-advancement (advancement.py) integrates psi; the CoM reference (reference.py) is x_d(psi)
-and its derivatives; the contact schedule (control/schedule.py), the controller's model
+advancement (advancement.py) integrates psi; the CoM reference (com_path.py) is x_d(psi)
+and its derivatives; the contact schedule (contact_schedule.py), the controller's model
 with its mass estimate (control/model.py, control/mass.py) and the task references
-(control/references.py) feed the whole-body QP (control/controller.py).
+(task_references.py) feed the whole-body QP (control/controller.py).
 
 Inputs (a station's outputs of the same names, station.py): robot_state, pad_forces_W,
 seat_pad_normal_forces_N, pads_vertical_force_N, hand_wrenches_W (measured), com_W,
@@ -31,20 +31,19 @@ from functools import partial
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from drake_standup.config import Scenario
-from drake_standup.config.phases import resolve_com_heights
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
 from drake_standup.standup.advancement import TrajectoryAdvancement
 from drake_standup.standup.com_path import CoMReferenceGenerator
 from drake_standup.standup.contact_schedule import ContactScheduler
+from drake_standup.standup.plan import StandupPlan
 from drake_standup.standup.state_machine import StandupStateMachine
 from drake_standup.standup.task_references import (
     ReferenceGenerator,
     StandupSchedule,
     TaskReferenceGenerator,
 )
-from drake_standup.world.scene import erect_com_height_m
 from drake_standup.world.sensing import standing_lean
 from drake_standup.world.station import Station
 
@@ -113,14 +112,13 @@ class StandupController:
     controller: WholeBodyController  # for its compute times (bench.py)
 
 
-def make_standup_controller(scenario: Scenario, station: Station) -> StandupController:
-    """The diagram of the module docstring for the station's robot."""
+def make_standup_controller(
+    scenario: Scenario, station: Station, plan: StandupPlan
+) -> StandupController:
+    """The diagram of the module docstring for the station's robot and its plan."""
     plant, robot = station.plant, station.robot
     config, period_s = scenario.controller, scenario.controller_period_s
-    # Each robot stands at its own erect height (phases.Phase.com_height_erect).
-    table = resolve_com_heights(
-        scenario.phases, lambda posture: erect_com_height_m(station.scene, scenario, posture)
-    )
+    table = plan.table
     g = -plant.gravity_field().gravity_vector()[2]
     specs = contact_specs(plant, robot, config)
     joints = ControllerJoints.of(plant, robot)
