@@ -77,7 +77,7 @@ class ControllerConfig:
     # A seated pad's normal-force bound: above the robot's weight (324 N), never binding. N.
     seat_max_normal_force_N: float = 400.0
     # A releasing seat pad is also bounded by its measured normal force plus this
-    # (control/schedule.py): the QP planned on more than the compliant pads carried. N.
+    # (standup/contact_schedule.py): the QP planned on more than the compliant pads carried. N.
     seat_measured_margin_N: float = 20.0
     # Sole normal-force bound: three times the robot's weight, never binding. N.
     foot_max_normal_force_N: float = 1000.0
@@ -110,7 +110,7 @@ class ControllerConfig:
     # near straight legs 1 cm of CoM height is 0.3 rad of knee.
     stance_from_progress: float = 0.7
     stance_vertical_weight_scale: float = 0.1
-    # Integral gain on the CoM height error in the stance (control/references.py). 1/s^3.
+    # Integral gain on the CoM height error in the stance (standup/task_references.py). 1/s^3.
     stance_height_ki_per_s3: float = 100.0
     # The lean's first-order lag: the pull's moment, not its jitter, and about the CoM
     # loop's own time, so that a robot leaning into a pull is upright soon after the

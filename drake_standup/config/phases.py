@@ -80,7 +80,7 @@ class Guard:
 class Phase:
     """One stand-up state's behaviour."""
 
-    # The CoM segment the phase follows from its entry (reference.py: min jerk): its
+    # The CoM segment the phase follows from its entry (com_path.py: min jerk): its
     # length in psi (= s at psi = t), its displacement, optionally an absolute end height
     # (replacing the displacement's z) and a start at the CoM's measured height instead of
     # the previous segment's end. In `seated` the length is that of the return to the

@@ -64,7 +64,7 @@ class RobotConfig:
     # 1000 faces they take ~1.3 MB and a 15 s recording stays under 8 MB.
     visual_max_faces: int = 1000
     # The motors' reflected inertia (gear ratio^2 x rotor inertia on each actuated
-    # joint, robot.py MOTOR_INERTIAS), in the plant and the controller's model alike:
+    # joint, robot/icub.py MOTOR_INERTIAS), in the plant and the controller's model alike:
     # none | all | real_robots (every model but the Gazebo ones). As the authors had it
     # (SPEC 9: on for the real robots, off in Gazebo); the convergence study found it
     # cheaper per step and converged at a larger step (docs/performance.md).
@@ -212,14 +212,14 @@ class AdvancementConfig:
 
 @dataclass
 class ComplianceConfig:
-    """The CoM reference's admittance for response: compliant (control/references.py):
+    """The CoM reference's admittance for response: compliant (standup/task_references.py):
 
         M a + D v + K x = f_hands,   D = 2 zeta sqrt(K M),
 
     x the reference's offset (W), f_hands the measured pull of both hands. Bounded so the
     robot stays over its support: each axis within max_offset_m; horizontally only as far
     as the standing feet could still hold the pull (standup.standing_pull_usage_limit);
-    on the feet alone not above the path (control/references.py)."""
+    on the feet alone not above the path (standup/task_references.py)."""
 
     # The robot's own mass (iCubGazeboV2_5: 33 kg): the reference yields to the pull as
     # the robot itself would, free, at first (Omega f = f / m, SPEC 2). kg.

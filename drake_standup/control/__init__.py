@@ -1,16 +1,16 @@
 """The whole-body controller's parts, each one idea (dairlib OSC style).
 
     terms.py       the robot's kinematic and dynamic terms at one state (M, h, J, Jdot v, CoM)
-    contacts.py    contact wrenches: friction pyramid, CoP box, normal-force bounds, maps
-    schedule.py    the contact schedule: from the stand-up mode, the contacts' bounds and
-                   the seat's hold (ContactScheduler)
+    contacts.py    contact wrenches: friction pyramid, CoP box, normal-force bounds, maps;
+                   the controller's contact set (CONTACTS) and what a plan asks of it
+                   (ContactCommands, made by standup/contact_schedule.py)
     mass.py        the mass estimate: the robot weighs itself seated (MassEstimator)
     model.py       the controller's model: its contacts and joints, the terms once a tick
                    (ControllerModel)
-    references.py  what the tasks track: the phase table's gains, postures and base pitch,
-                   and each tick's references (Ldot*, f_par, q_ref; TaskReferenceGenerator)
+    targets.py     what the tasks track: one mode's settings and one tick's references
+                   (TaskReferences, made by standup/task_references.py)
     tasks.py       Task objects (centroidal momentum, CoP centering, posture, base
-                   orientation), each with its weight, active states and update(), and
+                   orientation), each with its weight, active modes and update(), and
                    the joint-limit acceleration bounds
     qp.py          the one QP over [contact wrenches, vdot], which consumes any list of
                    tasks, and its solver backends

@@ -2,7 +2,7 @@
 
 Each task is w ||A z[columns] - b||^2 over the QP's unknowns z = [F_1 .. F_nc, vdot],
 refreshed by update(terms, references) from one tick's TaskReferences
-(control/references.py):
+(standup/task_references.py):
 
     momentum          sum_c X_Com,c F_c = Ldot* - [0; m g] - W_hand,Com
     posture           qddot = qddot* = -K_P (q - q_ref) - K_D qdot

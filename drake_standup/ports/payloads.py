@@ -3,8 +3,8 @@
 A VectorLayout names the entries of a vector port once, for its producer and every
 reader: `HAND_WRENCHES["f_l"]` is the slice of the left hand's force, and
 `DIAGNOSTICS.unpack(row)` the named parts of a logged row. Payloads that are not logged
-travel as abstract values of documented dataclasses (control/schedule.py:
-ContactCommands, control/references.py: TaskReferences, state_machine.py: StandupMode).
+travel as abstract values of documented dataclasses (control/contacts.py:
+ContactCommands, control/targets.py: TaskReferences, state_machine.py: StandupMode).
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ class VectorLayout:
 # force] of the left hand, then of the right. N m, N.
 HAND_WRENCHES = VectorLayout(("tau_l", 3), ("f_l", 3), ("tau_r", 3), ("f_r", 3))
 
-# A CoM segment of the reference (reference.py): psi at its start, its length in psi,
+# A CoM segment of the reference (com_path.py): psi at its start, its length in psi,
 # where it starts and its displacement (world, m).
 SEGMENT = VectorLayout(("psi_entry", 1), ("psi_length", 1), ("x_start", 3), ("delta", 3))
 

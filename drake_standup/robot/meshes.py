@@ -3,7 +3,7 @@
 Drake reads no STL (RobotLocomotion/drake#19408), so every mesh the iCub URDF
 names is converted once into a cache directory outside the repository and
 reused afterwards. The meshes are only used for illustration (the robot's
-collision geometry is a set of primitives, see robot.py), so they are
+collision geometry is a set of primitives, see robot/icub.py), so they are
 decimated with quadric edge collapse to keep the Meshcat recording small.
 """
 

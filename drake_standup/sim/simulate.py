@@ -1,7 +1,7 @@
 """simulate(scenario, out_dir): one scenario to its end, with its files.
 
 The run itself is runner.py's (prepare, advance, collect), shown as a progress bar; the
-psi = t run beside it (baseline.py) gives the figure its faded reference; outputs.py
+psi = t run beside it (baseline.py) gives the figure its faded reference; run_folder.py
 writes the files. run_diagram.py, the benchmark and the sweeps call this.
 """
 

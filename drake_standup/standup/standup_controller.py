@@ -16,7 +16,7 @@ Inputs (a station's outputs of the same names, station.py): robot_state, pad_for
 seat_pad_normal_forces_N, pads_vertical_force_N, hand_wrenches_W (measured), com_W,
 com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, standing_pull_usage; response (1: the
 response code, config.RESPONSES' index: which of the pull the advancement and the task
-references take, control/references.py); and stand_up (1; > 0.5: start; unconnected:
+references take, standup/task_references.py); and stand_up (1; > 0.5: start; unconnected:
 never), which only the live helper has.
 Outputs: actuation; controller_diagnostics (control/controller.py: DIAGNOSTICS); psi,
 psi_dot, alpha; com_reference, x_d_W; standup_state, held_back, segment, entry_times_s;
