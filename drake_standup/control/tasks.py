@@ -218,10 +218,13 @@ def joint_limit_acceleration_bounds(
     q_max: np.ndarray,
     horizon_s: float,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Joint accelerations that keep q in [q_min, q_max] over the next horizon_s at
-    constant acceleration: q + T qdot + T^2/2 qddot in the limits,
+    """Joint accelerations that put q inside [q_min, q_max] at the end of the next
+    horizon_s at constant acceleration: q + T qdot + T^2/2 qddot in the limits,
 
-    2 (q_min - q - T qdot) / T^2 <= qddot <= 2 (q_max - q - T qdot) / T^2."""
+    2 (q_min - q - T qdot) / T^2 <= qddot <= 2 (q_max - q - T qdot) / T^2.
+
+    Only the horizon's end is bounded: a joint running at its limit may pass it on the
+    way; re-evaluated each tick at the bound it is a spring of damping ratio 1/sqrt(2)."""
     scale = 2.0 / horizon_s**2
     q_coasting = q + horizon_s * qdot
     return scale * (q_min - q_coasting), scale * (q_max - q_coasting)
