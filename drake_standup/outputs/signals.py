@@ -131,7 +131,7 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
         "hindered": held[:, 0] > 0.5,
         "held_back_s": held[:, 1],
         # A pull beyond what the standing robot's feet can hold, and how long it held
-        # the stand-up back (state_machine.py).
+        # the stand-up back (standup/transitions.py).
         "pull_beyond_feet": held[:, 2] > 0.5,
         "held_back_beyond_feet_s": held[:, 3],
     }
