@@ -1,6 +1,7 @@
-"""Imports run one way, and the package stays readable: no cycle among the package's modules, counting every import
-statement anywhere in a file (in functions and under `if TYPE_CHECKING:` too) and every
-importlib.import_module("drake_standup...") of a literal name."""
+"""Imports run one way, and the package stays readable: no cycle among the package's
+modules, counting every import statement anywhere in a file (in functions and under
+`if TYPE_CHECKING:` too) and every importlib.import_module("drake_standup...") of a
+literal name."""
 
 from __future__ import annotations
 
