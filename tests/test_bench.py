@@ -203,7 +203,7 @@ def test_an_output_file_that_cannot_be_written_is_one_error_line_before_any_run(
     in_the_way = tmp_path / "file"
     in_the_way.write_text("")
     path = in_the_way / "bench.json" if where == "under a file" else tmp_path
-    monkeypatch.setattr(bench, "_model_build", lambda _: pytest.fail("ran before the check"))
+    monkeypatch.setattr(bench, "time_model_build", lambda _: pytest.fail("ran before the check"))
     assert bench.main([*TINY, flag, str(path)]) == 2
     captured = capsys.readouterr()
     assert captured.out == ""

@@ -27,13 +27,13 @@ from drake_standup.control.model import ControllerJoints, ControllerModel, conta
 from drake_standup.control.qp import as_slice
 from drake_standup.control.terms import RobotKinematics
 from drake_standup.standup.contact_schedule import contact_commands, phase_seat_hold
-from drake_standup.standup.state_machine import initial_mode
 from drake_standup.standup.task_references import (
     ReferenceGenerator,
     StandupSchedule,
     TaskReferenceGenerator,
     helpful_force,
 )
+from drake_standup.standup.transitions import initial_mode
 from drake_standup.world.scene import add_scene, set_seated_state
 
 G = 9.81

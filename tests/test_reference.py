@@ -9,7 +9,7 @@ import pytest
 from drake_standup.config import StandupConfig
 from drake_standup.config.phases import PhaseTable, resolve_com_heights
 from drake_standup.standup.com_path import CoMReferenceGenerator, min_jerk, path
-from drake_standup.standup.state_machine import Measurements, initial_mode, next_mode
+from drake_standup.standup.transitions import Measurements, initial_mode, next_mode
 
 SEGMENT = np.array([0.7, 1.5, 0.06, 0.0, 0.38, 0.1277, -0.01, 0.03])  # psi_e, T, x0, delta
 
@@ -103,7 +103,7 @@ def test_path_is_continuous_in_value_and_slope_across_switches():
             after = path(new.segment(), m.psi)
             if new.state == 3:
                 # Bumpless into state 3's stiffer height gain: the height restarts at
-                # the CoM's (state_machine._enter).
+                # the CoM's (transitions._enter).
                 before[0][2] = m.com_W[2]
             np.testing.assert_allclose(after[0], before[0], atol=1e-12)  # value
             np.testing.assert_allclose(after[1], before[1], atol=1e-12)  # slope

@@ -19,7 +19,7 @@ from drake_standup.standup.contact_schedule import (
     next_unload_from,
     phase_seat_hold,
 )
-from drake_standup.standup.state_machine import Measurements, _enter, _sit_back, initial_mode
+from drake_standup.standup.transitions import Measurements, _enter, _sit_back, initial_mode
 
 CONFIG = ControllerConfig()
 TABLE = PhaseTable()

@@ -8,7 +8,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from drake_standup.robot.icub import original_urdf
+from drake_standup.robot.urdf import original_urdf
 
 pytestmark = pytest.mark.slow
 

@@ -13,11 +13,11 @@ from pydrake.systems.analysis import Simulator
 
 from drake_standup.config import StandupConfig
 from drake_standup.config.phases import PhaseTable
-from drake_standup.standup.state_machine import (
+from drake_standup.standup.state_machine import StandupStateMachine
+from drake_standup.standup.transitions import (
     GuardSignals,
     Measurements,
     SchmittTrigger,
-    StandupStateMachine,
     _enter,
     _sit_back,
     initial_mode,

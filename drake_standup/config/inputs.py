@@ -229,7 +229,7 @@ def model_names(model: str) -> ModelNames:
     for joint in joints:
         children[joint.find("parent").get("link")].append(joint.find("child").get("link"))
 
-    # robot._remove_bare_subtrees' rule (tests/test_inputs.py checks it on a built plant):
+    # urdf._remove_bare_subtrees' rule (tests/test_inputs.py checks it on a built plant):
     # a link without mass or visual on a fixed joint, all its children alike, is a frame.
     @functools.cache
     def becomes_frame(name: str) -> bool:

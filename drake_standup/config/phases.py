@@ -32,7 +32,7 @@ PHASES = ("seated", "forward", "lift_off", "rise")
 # Pad groups of the chair whose load a phase can release (models/icub_contact.yaml).
 SEAT_PADS = ("buttocks", "thighs")
 SEAT_HOLDS = ("held", "hinged")
-# What a phase does under a pull against the stand-up (state_machine.py).
+# What a phase does under a pull against the stand-up (standup/transitions.py).
 WHEN_HINDERED = ("wait", "sit_back", "step_back", "stand")
 
 _LEGS = ("hip_pitch", "hip_roll", "knee", "ankle_pitch")
@@ -54,7 +54,7 @@ def posture(values: list[float]) -> dict[str, float]:
 @dataclass
 class Guard:
     """What leaves a phase: every condition set here holds, and no pull against the
-    stand-up has been felt for standup.resume_after_s (state_machine.py)."""
+    stand-up has been felt for standup.resume_after_s (standup/transitions.py)."""
 
     # At least this long in the phase. s.
     min_time_s: float = 0.0

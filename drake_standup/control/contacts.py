@@ -78,7 +78,7 @@ def wrench_cone_matrix(spec: ContactSpec) -> np.ndarray:
     )
 
 
-# The controller's contacts: the seat pads (state_machine.SEAT_LOADS' order) and soles.
+# The controller's contacts: the seat pads (transitions.SEAT_LOADS' order) and soles.
 CONTACTS = ("seat", "l_thigh", "r_thigh", "l_sole", "r_sole")
 CHAIR = slice(0, 3)
 SOLES = slice(3, 5)

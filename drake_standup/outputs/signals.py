@@ -58,6 +58,16 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
     """Every logger's series (diagram.StandupDiagram.logs) as named arrays on one time grid
     (rows = samples): what signals.npz holds, and what the metrics and figures are
     computed from."""
+    logs = _read_logs(built, root_context)
+    signals = _station_signals(built.station, logs)
+    if "controller_diagnostics" not in logs:  # the seat-hold benchmark: no controller
+        return signals
+    signals |= _controller_signals(logs)
+    return signals
+
+
+def _read_logs(built, root_context) -> dict[str, np.ndarray]:
+    """Each logger's data (rows = samples) by name, and time_s, their common time grid."""
     logs = {}
     for name, logger in built.logs.items():
         log = logger.FindLog(root_context)
@@ -66,8 +76,12 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
         t = logs.setdefault("time_s", times.copy())
         if not np.array_equal(times, t):
             raise RuntimeError(f"logger {name} is not on the common time grid")
+    return logs
+
+
+def _station_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The station's signals (every run has them), and the human's and pushes' logged."""
     t = logs["time_s"]
-    station = built.station
     nq = station.plant.num_positions(station.robot.model_instance)
     joints = station.joints
     state = logs["robot_state"]
@@ -96,8 +110,13 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
     if "helper_spent" in logs:  # human.HelperWork's running totals, on the plant's steps
         for k, name in enumerate(HELPER_SPENT):
             signals[name] = logs["helper_spent"][:, k]
-    if "controller_diagnostics" not in logs:  # the seat-hold benchmark: no controller
-        return signals
+    return signals
+
+
+def _controller_signals(logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The stand-up controller's signals: the response, the reference, psi, the state,
+    the QP's diagnostics, what a pull held back."""
+    signals = {}
     if "response" in logs:  # the robot's response to the pull, as an index of responses
         signals["response"] = np.rint(logs["response"][:, 0]).astype(np.int8)
         signals["responses"] = np.array(RESPONSES, dtype=str)
@@ -131,7 +150,7 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
         "hindered": held[:, 0] > 0.5,
         "held_back_s": held[:, 1],
         # A pull beyond what the standing robot's feet can hold, and how long it held
-        # the stand-up back (state_machine.py).
+        # the stand-up back (standup/transitions.py).
         "pull_beyond_feet": held[:, 2] > 0.5,
         "held_back_beyond_feet_s": held[:, 3],
     }

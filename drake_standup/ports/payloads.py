@@ -4,7 +4,7 @@ A VectorLayout names the entries of a vector port once, for its producer and eve
 reader: `HAND_WRENCHES["f_l"]` is the slice of the left hand's force, and
 `DIAGNOSTICS.unpack(row)` the named parts of a logged row. Payloads that are not logged
 travel as abstract values of documented dataclasses (control/contacts.py:
-ContactCommands, control/targets.py: TaskReferences, state_machine.py: StandupMode).
+ContactCommands, control/targets.py: TaskReferences, standup/transitions.py: StandupMode).
 """
 
 from __future__ import annotations

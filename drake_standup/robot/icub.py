@@ -1,23 +1,16 @@
-"""The iCub from icub-models, made Drake-ready.
+"""The iCub from icub-models, made Drake-ready, added to a plant; its joint tables.
 
-What this module does to the published URDF, in order:
-  1. Converts its STL visuals to decimated OBJ in a cache (meshes.py); Drake
-     reads no STL.
-  2. Drops every URDF collision element: the task needs contact only where the
-     robot meets chair and floor, given as primitives in models/icub_contact.yaml.
-  3. Optionally ("reduced") removes the massless, visual-less links that hang
-     on fixed joints (sensor and skin frames, about 170 of the 210 links) and
-     adds each back as a FixedOffsetFrame on its nearest kept ancestor, so
-     every named frame survives while the tree Drake integrates shrinks to
-     about 40 bodies (same mass matrix, CoM and frame poses; tests check it).
-  4. Adds a JointActuator per revolute joint with the scenario's effort limit and,
+add_icub parses the URDF that urdf.py prepared (STL visuals as OBJ, no collision
+elements, optionally reduced to the ~40 bodies that carry mass or show something) and:
+  1. Adds back the removed bare links as FixedOffsetFrames on their kept ancestors.
+  2. Adds the contact primitives and frames of models/icub_contact.yaml.
+  3. Adds a JointActuator per revolute joint with the scenario's effort limit and,
      if asked, the motor's rotor inertia and gear ratio (MOTOR_INERTIAS).
+Then the joint tables: positions by joint name, vectors in actuator order, and where
+each actuated joint sits in the state (actuated_joints).
 """
 
 import copy
-import hashlib
-import os
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -44,11 +37,14 @@ from pydrake.multibody.tree import (
     RevoluteJoint,
 )
 
-from drake_standup.config.inputs import CONTACT_FILE, TASK_FRAMES, robot_names
+from drake_standup.config.inputs import CONTACT_FILE, TASK_FRAMES
 from drake_standup.config.scenario import EFFORT_LIMIT_NM, REFLECTED_INERTIA
-from drake_standup.robot.meshes import cache_dir, converted_obj
-
-DEFAULT_MODEL = "iCubGazeboV2_5"
+from drake_standup.robot.urdf import (
+    DEFAULT_MODEL,
+    LeafFrame,
+    ModelError,
+    prepare_urdf,
+)
 
 # The motors of the authors' controller model (SPEC 9): gear ratio 100 on every joint;
 # rotor inertia 0.0827e-4 kg m^2 on the legs and torso pitch/roll, 0.0585e-4 on torso yaw
@@ -81,166 +77,6 @@ def reflects_motor_inertia(setting: str, model_name: str) -> bool:
             f"robot.reflected_inertia: '{setting}'; accepted: none | all | real_robots"
         )
     return setting == "all" or (setting == "real_robots" and "Gazebo" not in model_name)
-
-
-class ModelError(ValueError):
-    """Raised for a robot model that cannot be loaded (one-line message)."""
-
-
-def original_urdf(model_name: str) -> Path:
-    """Path of the URDF that icub-models installs for model_name."""
-    import icub_models
-
-    names = robot_names()
-    if model_name not in names:
-        raise ModelError(f"robot.model: unknown model '{model_name}'; accepted: {', '.join(names)}")
-    return Path(icub_models.get_model_file(model_name))
-
-
-def _pose(elem: ET.Element | None) -> RigidTransform:
-    """Pose of a URDF <origin> (fixed-axis roll-pitch-yaw, as Drake's RPY)."""
-    if elem is None:
-        return RigidTransform()
-    xyz = [float(s) for s in elem.get("xyz", "0 0 0").split()]
-    rpy = [float(s) for s in elem.get("rpy", "0 0 0").split()]
-    return RigidTransform(RollPitchYaw(rpy), xyz)
-
-
-def _is_bare(link: ET.Element) -> bool:
-    """True for a link that carries no mass and shows nothing."""
-    if link.find("visual") is not None:
-        return False
-    inertial = link.find("inertial")
-    if inertial is None:
-        return True
-    mass = inertial.find("mass")
-    return mass is None or float(mass.get("value", "0")) == 0.0
-
-
-@dataclass
-class LeafFrame:
-    """A removed bare link, kept as a frame fixed on its nearest kept ancestor."""
-
-    name: str
-    parent_body: str
-    X_PF: RigidTransform
-
-
-@dataclass
-class PreparedUrdf:
-    """A Drake-ready URDF in the cache and the frames to re-attach after parsing."""
-
-    path: Path
-    leaf_frames: list[LeafFrame]
-
-
-# prepare_urdf's results in this process, by its arguments and the cache directory.
-_PREPARED: dict[tuple, PreparedUrdf] = {}
-
-
-def prepare_urdf(
-    model_name: str = DEFAULT_MODEL,
-    *,
-    reduce: bool = True,
-    visuals: bool = True,
-    visual_max_faces: int = 1000,
-) -> PreparedUrdf:
-    """Rewrites the icub-models URDF for Drake (see the module docstring).
-
-    Once per process and arguments while the cached file exists: the rewrite
-    (parse, mesh look-ups, serialise, hash) cost ~15 ms of every
-    build_diagram, which a sweep pays for every run (measured)."""
-    key = (model_name, reduce, visuals, visual_max_faces, str(cache_dir()))
-    prepared = _PREPARED.get(key)
-    if prepared is None or not prepared.path.exists():
-        prepared = _PREPARED[key] = _prepare_urdf(
-            model_name, reduce=reduce, visuals=visuals, visual_max_faces=visual_max_faces
-        )
-    return PreparedUrdf(prepared.path, list(prepared.leaf_frames))
-
-
-def _prepare_urdf(
-    model_name: str, *, reduce: bool, visuals: bool, visual_max_faces: int
-) -> PreparedUrdf:
-    src = original_urdf(model_name)
-    share_icub = src.parent.parent.parent  # .../share/iCub (package://iCub/)
-    tree = ET.parse(src)
-    robot = tree.getroot()
-
-    for tag in ("gazebo", "sensor"):
-        for elem in robot.findall(tag):
-            robot.remove(elem)
-
-    links = {link.get("name"): link for link in robot.findall("link")}
-    for link in links.values():
-        for col in link.findall("collision"):
-            link.remove(col)
-        for vis in link.findall("visual"):
-            mesh = vis.find("geometry/mesh")
-            if not visuals:
-                link.remove(vis)
-            elif mesh is not None:
-                uri = mesh.get("filename")
-                stl = share_icub / uri.removeprefix("package://iCub/")
-                scale = [float(s) for s in mesh.get("scale", "1 1 1").split()]
-                mesh.set("filename", str(converted_obj(stl, scale, visual_max_faces)))
-                mesh.attrib.pop("scale", None)
-
-    leaf_frames: list[LeafFrame] = []
-    if reduce:
-        leaf_frames = _remove_bare_subtrees(robot, links)
-
-    digest = hashlib.sha1(ET.tostring(robot)).hexdigest()[:12]
-    kind = "reduced" if reduce else "full"
-    out = cache_dir() / "urdf" / f"{model_name}-{kind}-{digest}.urdf"
-    if not out.exists():
-        out.parent.mkdir(parents=True, exist_ok=True)
-        # Write then rename: a half-written file must never look cached.
-        tmp = out.with_name(f"{out.name}.{os.getpid()}.tmp")
-        tree.write(tmp)
-        tmp.replace(out)
-    return PreparedUrdf(out, leaf_frames)
-
-
-def _remove_bare_subtrees(robot: ET.Element, links: dict[str, ET.Element]) -> list[LeafFrame]:
-    """Removes every subtree of bare links on fixed joints; returns their frames."""
-    joints = robot.findall("joint")
-    children: dict[str, list[ET.Element]] = {name: [] for name in links}
-    parent_joint: dict[str, ET.Element] = {}
-    for joint in joints:
-        children[joint.find("parent").get("link")].append(joint)
-        parent_joint[joint.find("child").get("link")] = joint
-
-    def child_of(joint: ET.Element) -> str:
-        return joint.find("child").get("link")
-
-    def removable(name: str) -> bool:
-        joint = parent_joint.get(name)
-        return (
-            joint is not None
-            and joint.get("type") == "fixed"
-            and _is_bare(links[name])
-            and all(removable(child_of(j)) for j in children[name])
-        )
-
-    frames: list[LeafFrame] = []
-
-    def collect(name: str, kept: str, X_KL: RigidTransform) -> None:
-        frames.append(LeafFrame(name, kept, X_KL))
-        for j in children[name]:
-            collect(child_of(j), kept, X_KL @ _pose(j.find("origin")))
-
-    for joint in joints:
-        parent = joint.find("parent").get("link")
-        if removable(child_of(joint)) and not removable(parent):
-            collect(child_of(joint), parent, _pose(joint.find("origin")))
-    removed = {f.name for f in frames}
-    for joint in joints:
-        if child_of(joint) in removed:
-            robot.remove(joint)
-    for name in removed:
-        robot.remove(links[name])
-    return frames
 
 
 # --- Contact geometry --------------------------------------------------------
@@ -366,19 +202,50 @@ def add_icub(
     )
     parser = Parser(plant)
     (instance,) = parser.AddModels(str(prepared.path))
+    contact = contact if contact is not None else load_contact_model()
+    X_BF = _add_frames(plant, instance, prepared.leaf_frames, contact)
+    joint_names = _add_actuators(plant, instance, effort_limit_Nm, pd_gains, motor_inertia)
+    groups, geometries = _add_contact_geometry(plant, instance, contact, X_BF)
+    return Robot(
+        instance,
+        model_name,
+        joint_names,
+        groups,
+        geometries,
+        list(contact.shapes),
+        prepared.leaf_frames,
+    )
 
-    for leaf in prepared.leaf_frames:
+
+def _add_frames(
+    plant: MultibodyPlant,
+    instance: ModelInstanceIndex,
+    leaf_frames: list[LeafFrame],
+    contact: ContactModel,
+) -> dict[str, RigidTransform]:
+    """Adds the removed bare links' frames and the contact model's frames; returns the pose
+    of each in its body (before Finalize, frame poses are known only from these tables)."""
+    for leaf in leaf_frames:
         parent = plant.GetBodyByName(leaf.parent_body, instance)
         plant.AddFrame(FixedOffsetFrame(leaf.name, parent.body_frame(), leaf.X_PF))
 
-    contact = contact if contact is not None else load_contact_model()
-    X_BF: dict[str, RigidTransform] = {f.name: f.X_PF for f in prepared.leaf_frames}
+    X_BF: dict[str, RigidTransform] = {f.name: f.X_PF for f in leaf_frames}
     for spec in contact.frames:
         parent = plant.GetFrameByName(spec.parent, instance)
         X_PF = RigidTransform(RollPitchYaw(spec.rpy_rad), spec.xyz_m)
         X_BF[spec.name] = X_BF.get(spec.parent, RigidTransform()) @ X_PF
         plant.AddFrame(FixedOffsetFrame(spec.name, parent, X_PF))
+    return X_BF
 
+
+def _add_actuators(
+    plant: MultibodyPlant,
+    instance: ModelInstanceIndex,
+    effort_limit_Nm: float,
+    pd_gains: tuple[float, float] | None,
+    motor_inertia: bool,
+) -> list[str]:
+    """Adds a JointActuator per revolute joint (see add_icub); returns their joints' names."""
     joint_names = []
     for index in plant.GetJointIndices(instance):
         joint = plant.get_joint(index)
@@ -391,7 +258,17 @@ def add_icub(
             if pd_gains is not None:
                 kp, kd = pd_gains
                 actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))
+    return joint_names
 
+
+def _add_contact_geometry(
+    plant: MultibodyPlant,
+    instance: ModelInstanceIndex,
+    contact: ContactModel,
+    X_BF: dict[str, RigidTransform],
+) -> tuple[dict[str, list[str]], dict[str, GeometryId]]:
+    """Registers the contact model's shapes (none without a scene graph); returns group ->
+    geometry names and geometry name -> id."""
     groups: dict[str, list[str]] = {}
     geometries: dict[str, GeometryId] = {}
     if plant.geometry_source_is_registered():
@@ -415,15 +292,7 @@ def add_icub(
                 frame.body(), X_BG, _shape(spec), spec.name, props
             )
             groups.setdefault(spec.group, []).append(spec.name)
-    return Robot(
-        instance,
-        model_name,
-        joint_names,
-        groups,
-        geometries,
-        list(contact.shapes),
-        prepared.leaf_frames,
-    )
+    return groups, geometries
 
 
 def set_joint_positions(

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.geometry import Meshcat, MeshcatVisualizer, MeshcatVisualizerParams, Role
 from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
-from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
+from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort, System
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
 
 from drake_standup.config import RESPONSES, Scenario, validate
@@ -20,7 +20,7 @@ from drake_standup.control.controller import WholeBodyController
 from drake_standup.robot.icub import actuated_joints
 from drake_standup.sim.visuals import StandupVisuals
 from drake_standup.standup.plan import StandupPlan, make_plan
-from drake_standup.standup.standup_controller import make_standup_controller
+from drake_standup.standup.standup_controller import StandupController, make_standup_controller
 from drake_standup.world.human import HelperWork, HumanWrenchSource
 from drake_standup.world.scene import Scene, set_seated_state
 from drake_standup.world.station import Station, make_station
@@ -96,6 +96,36 @@ def build_diagram(
     )
     plan = make_plan(scenario, station.scene)
     builder = DiagramBuilder()
+    world, human, outputs = _add_station_and_human(builder, station, scenario, make_human)
+    standup = None
+    if seat_hold:
+        add_seat_hold(
+            builder,
+            station.scene,
+            scenario,
+            world.GetInputPort("desired_state"),
+            world.GetInputPort("actuation"),
+        )
+    else:
+        standup = _add_standup_controller(builder, scenario, station, plan, world, human, outputs)
+    logs = _export_and_log(builder, outputs, scenario.log_period_s)
+    visualizer = None
+    if meshcat is not None:
+        visualizer = _add_meshcat(builder, world, scenario, meshcat)
+        if standup is not None:
+            _add_visuals(builder, station, scenario, meshcat, outputs, plan.n_states)
+    diagram = builder.Build()
+    diagram.set_name("standup")
+    return StandupDiagram(
+        diagram, station, None if standup is None else standup.controller, logs, visualizer, plan
+    )
+
+
+def _add_station_and_human(
+    builder: DiagramBuilder, station: Station, scenario: Scenario, make_human: Callable | None
+) -> tuple[System, System, dict[str, OutputPort]]:
+    """The station, the human pulling at its hands and what the helper spends, wired;
+    returns the station's and the human's systems and their outputs to export by name."""
     world = builder.AddNamedSystem("station", station.diagram)
     human = builder.AddNamedSystem(
         "human", (make_human or HumanWrenchSource)(station.plant, station.robot, scenario.human)
@@ -116,50 +146,52 @@ def build_diagram(
     outputs["helper_spent"] = spent.GetOutputPort("helper_spent")
     if station.diagram.HasOutputPort("push_force_W"):
         outputs["push_force_W"] = world.GetOutputPort("push_force_W")
-    standup = None
-    if seat_hold:
-        add_seat_hold(
-            builder,
-            station.scene,
-            scenario,
-            world.GetInputPort("desired_state"),
-            world.GetInputPort("actuation"),
-        )
+    return world, human, outputs
+
+
+def _add_standup_controller(
+    builder: DiagramBuilder,
+    scenario: Scenario,
+    station: Station,
+    plan: StandupPlan,
+    world: System,
+    human: System,
+    outputs: dict[str, OutputPort],
+) -> StandupController:
+    """The stand-up controller, fed by the station (and the human's stand_up, if it has
+    one), driving its actuation; its signals and the response join outputs."""
+    standup = make_standup_controller(scenario, station, plan)
+    brain = builder.AddNamedSystem("standup_controller", standup.diagram)
+    # The robot's response to the pull: the scenario's, or the live helper's switch.
+    if human.HasOutputPort("response"):
+        outputs["response"] = human.GetOutputPort("response")
     else:
-        standup = make_standup_controller(scenario, station, plan)
-        brain = builder.AddNamedSystem("standup_controller", standup.diagram)
-        # The robot's response to the pull: the scenario's, or the live helper's switch.
-        if human.HasOutputPort("response"):
-            outputs["response"] = human.GetOutputPort("response")
-        else:
-            response = ConstantVectorSource([float(RESPONSES.index(scenario.response))])
-            outputs["response"] = builder.AddNamedSystem("response", response).get_output_port()
-        builder.Connect(outputs["response"], brain.GetInputPort("response"))
-        for i in range(brain.num_input_ports()):
-            port = brain.get_input_port(i)
-            if port.get_name() == "stand_up":
-                if human.HasOutputPort("stand_up"):
-                    builder.Connect(human.GetOutputPort("stand_up"), port)
-            elif port.get_name() != "response":
-                builder.Connect(world.GetOutputPort(port.get_name()), port)
-        builder.Connect(brain.GetOutputPort("actuation"), world.GetInputPort("actuation"))
-        outputs |= {name: brain.GetOutputPort(name) for name in CONTROLLER_SIGNALS}
+        response = ConstantVectorSource([float(RESPONSES.index(scenario.response))])
+        outputs["response"] = builder.AddNamedSystem("response", response).get_output_port()
+    builder.Connect(outputs["response"], brain.GetInputPort("response"))
+    for i in range(brain.num_input_ports()):
+        port = brain.get_input_port(i)
+        if port.get_name() == "stand_up":
+            if human.HasOutputPort("stand_up"):
+                builder.Connect(human.GetOutputPort("stand_up"), port)
+        elif port.get_name() != "response":
+            builder.Connect(world.GetOutputPort(port.get_name()), port)
+    builder.Connect(brain.GetOutputPort("actuation"), world.GetInputPort("actuation"))
+    outputs |= {name: brain.GetOutputPort(name) for name in CONTROLLER_SIGNALS}
+    return standup
+
+
+def _export_and_log(
+    builder: DiagramBuilder, outputs: dict[str, OutputPort], log_period_s: float
+) -> dict[str, VectorLogSink]:
+    """Exports every output by its name and logs those not UNLOGGED; returns the loggers."""
     logs = {}
     for name, port in outputs.items():
         builder.ExportOutput(port, name)
         if name not in UNLOGGED:
-            logs[name] = LogVectorOutput(port, builder, scenario.log_period_s)
+            logs[name] = LogVectorOutput(port, builder, log_period_s)
             logs[name].set_name(f"log_{name}")
-    visualizer = None
-    if meshcat is not None:
-        visualizer = _add_meshcat(builder, world, scenario, meshcat)
-        if standup is not None:
-            _add_visuals(builder, station, scenario, meshcat, outputs, plan.n_states)
-    diagram = builder.Build()
-    diagram.set_name("standup")
-    return StandupDiagram(
-        diagram, station, None if standup is None else standup.controller, logs, visualizer, plan
-    )
+    return logs
 
 
 def _add_meshcat(builder, world, scenario: Scenario, meshcat: Meshcat) -> MeshcatVisualizer:

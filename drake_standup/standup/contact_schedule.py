@@ -3,7 +3,7 @@
 The controller's contacts (CONTACTS): the seat (a 6-D contact on root_link under the
 buttocks, held at the hip axis), both thighs (point forces, pinned by the others) and
 both soles (6-D). The phase table (phases.py) says when each seat pad's load is released
-(state_machine.seat_loads: what is left of it, NaN while seated). From that:
+(transitions.seat_loads: what is left of it, NaN while seated). From that:
 
     chair contacts in the QP   while any seat pad is seated or still carries load
     seated pad                 f_z in [f_min, f_max_seat]
@@ -34,7 +34,7 @@ from drake_standup.config import ControllerConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.control.contacts import CHAIR, CONTACTS, HOLDS, SOLES, ContactCommands
 from drake_standup.ports.caching import declare_cached
-from drake_standup.standup.state_machine import StandupMode, seat_loads, seat_releases
+from drake_standup.standup.transitions import StandupMode, seat_loads, seat_releases
 
 
 def next_unload_from(

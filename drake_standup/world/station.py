@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydrake.multibody.plant import ExternallyAppliedSpatialForceMultiplexer, MultibodyPlant
-from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import MatrixGain, PassThrough
 
 from drake_standup.config import Scenario
@@ -91,6 +91,28 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
     check_com_heights(scene, scenario)
     plant, robot = scene.plant, scene.robot
     instance = robot.model_instance
+    pad_groups, reporter = _add_pad_forces(builder, plant, robot)
+    measured = _add_pushes_and_hand_sensors(builder, scenario, plant, robot)
+    standing, robot_state = _add_sensing(builder, scene, scenario, measured)
+
+    builder.ExportInput(plant.get_actuation_input_port(instance), "actuation")
+    if pd_gains is not None:
+        builder.ExportInput(plant.get_desired_state_input_port(instance), "desired_state")
+    builder.ExportOutput(robot_state, "robot_state")
+    builder.ExportOutput(plant.get_net_actuation_output_port(instance), "net_actuation")
+    builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
+    builder.ExportOutput(scene.scene_graph.get_query_output_port(), "query_object")
+    builder.ExportOutput(reporter.get_output_port(), "pad_forces_W")
+    diagram = builder.Build()
+    diagram.set_name("station")
+    return Station(diagram, scene, pad_groups, actuated_joints(plant, instance), standing)
+
+
+def _add_pad_forces(
+    builder: DiagramBuilder, plant: MultibodyPlant, robot: Robot
+) -> tuple[dict[str, str], ContactForceReporter]:
+    """The contact force on each pad and the leg force sensors made of them; returns pad
+    name -> group and the reporter (its output: pad_forces_W)."""
     pad_groups = {
         name: _GROUP_LABELS.get(group, group)
         for group, names in robot.contact_groups.items()
@@ -114,7 +136,14 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
         system = builder.AddNamedSystem(name, MatrixGain(gain))
         builder.Connect(reporter.get_output_port(), system.get_input_port())
         builder.ExportOutput(system.get_output_port(), name)
+    return pad_groups, reporter
 
+
+def _add_pushes_and_hand_sensors(
+    builder: DiagramBuilder, scenario: Scenario, plant: MultibodyPlant, robot: Robot
+) -> OutputPort:
+    """The hands' pull and the perturbation's pushes on the plant, and the hands' sensors
+    (noisy or not); returns the sensors' output, the measured hand wrenches."""
     pert = scenario.perturbation
     if pert.pushes:
         pushes = builder.AddNamedSystem("pushes", PushSource(plant, robot, pert.pushes))
@@ -135,7 +164,15 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
     builder.ExportInput(sensor.get_input_port(), "applied_hand_wrenches_W")
     measured = sensor.get_output_port()
     builder.ExportOutput(measured, "hand_wrenches_W")
+    return measured
 
+
+def _add_sensing(
+    builder: DiagramBuilder, scene: Scene, scenario: Scenario, measured: OutputPort
+) -> tuple[StandingSupport, OutputPort]:
+    """What the robot senses of itself (sensing.py), with what its standing feet can hold;
+    returns that StandingSupport and the robot's state output."""
+    plant, robot = scene.plant, scene.robot
     rise, config = scenario.phases.rise, scenario.controller
     hands, soles = standing_offsets_m(scene, scenario, rise.posture_rad)
     standing = StandingSupport(
@@ -150,22 +187,11 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
         "sensing",
         RobotSensing(plant, robot, heel_points(robot), thigh_points(robot), standing),
     )
-    robot_state = plant.get_state_output_port(instance)
+    robot_state = plant.get_state_output_port(robot.model_instance)
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
     builder.Connect(measured, sensing.GetInputPort("hand_wrenches_W"))
     for name in ("com_W", "com_velocity_W", "omega_f_W", "heel_x_W", "thigh_x_W"):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
     for name in ("standing_pull_usage", "hand_positions_W", "hand_velocities_W"):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
-
-    builder.ExportInput(plant.get_actuation_input_port(instance), "actuation")
-    if pd_gains is not None:
-        builder.ExportInput(plant.get_desired_state_input_port(instance), "desired_state")
-    builder.ExportOutput(robot_state, "robot_state")
-    builder.ExportOutput(plant.get_net_actuation_output_port(instance), "net_actuation")
-    builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
-    builder.ExportOutput(scene.scene_graph.get_query_output_port(), "query_object")
-    builder.ExportOutput(reporter.get_output_port(), "pad_forces_W")
-    diagram = builder.Build()
-    diagram.set_name("station")
-    return Station(diagram, scene, pad_groups, actuated_joints(plant, instance), standing)
+    return standing, robot_state

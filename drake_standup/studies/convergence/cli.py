@@ -42,13 +42,51 @@ from drake_standup.config.arguments import OneLineErrorParser, parse_set
 from drake_standup.config.inputs import check_output_dir
 from drake_standup.studies.convergence.cases import SCENARIOS, STEPS_MS
 from drake_standup.studies.convergence.report import fmt
-from drake_standup.studies.convergence.study import run_study
+from drake_standup.studies.convergence.study import StudyResult, run_study
 
 
 def main(
     argv: list[str] | None = None, prog: str = "python -m drake_standup.studies.convergence"
 ) -> int:
     """Parses argv, runs the study, prints what it wrote; 2 on a bad option."""
+    args = _parser(prog).parse_args(argv)
+    error = _options_error(args)
+    if error is not None:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    scenarios = list(dict.fromkeys(args.scenarios))
+    steps = sorted(set(args.steps_ms))
+    try:  # a bad --set fails now, on every scenario, not in the workers
+        overrides = _checked_overrides(args.set, scenarios)
+    except ScenarioError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    try:
+        result = run_study(
+            scenarios,
+            steps,
+            args.out,
+            workers=args.workers,
+            address=args.address,
+            fresh=args.fresh,
+            overrides=overrides,
+        )
+    except OSError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(
+            f"\ninterrupted: finished runs are kept in {args.out / 'runs'}; "
+            "the same command reuses them",
+            file=sys.stderr,
+        )
+        return 130
+    _print_result(result, args.docs)
+    return 0
+
+
+def _parser(prog: str) -> argparse.ArgumentParser:
+    """The command's options (the module docstring)."""
     parser = OneLineErrorParser(
         prog=prog,
         description=__doc__,
@@ -89,66 +127,47 @@ def main(
     parser.add_argument(
         "--docs", type=Path, default=None, help="also copy convergence.md and .png into DIR"
     )
-    args = parser.parse_args(argv)
+    return parser
+
+
+def _options_error(args: argparse.Namespace) -> str | None:
+    """What is wrong with the options but --set (None: nothing), before any run."""
     if args.workers < 1:
-        print(f"error: --workers: {args.workers}; accepted: an integer >= 1", file=sys.stderr)
-        return 2
+        return f"--workers: {args.workers}; accepted: an integer >= 1"
     bad = [s for s in args.steps_ms if not (math.isfinite(s) and s > 0)]
     if bad:
-        print(f"error: --steps-ms: {bad[0]}; accepted: steps > 0 (ms)", file=sys.stderr)
-        return 2
+        return f"--steps-ms: {bad[0]}; accepted: steps > 0 (ms)"
     shipped = sorted(p.stem for p in SCENARIO_DIR.glob("*.yaml"))
     unknown = [s for s in args.scenarios if s not in shipped]
     if unknown:
-        print(
-            f"error: --scenarios: '{unknown[0]}' unknown; accepted: {', '.join(shipped)}",
-            file=sys.stderr,
-        )
-        return 2
+        return f"--scenarios: '{unknown[0]}' unknown; accepted: {', '.join(shipped)}"
     try:  # a folder that cannot be written fails now, not after the runs
         check_output_dir(args.out, "--out")
         if args.docs is not None:
             check_output_dir(args.docs, "--docs")
     except ScenarioError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
-    scenarios = list(dict.fromkeys(args.scenarios))
-    steps = sorted(set(args.steps_ms))
-    try:  # a bad --set fails now, on every scenario, not in the workers
-        overrides = [parse_set(text) for text in args.set]
-        for name in scenarios:
-            path = SCENARIO_DIR / f"{name}.yaml"
-            parse_scenario(path.read_text(), f"scenarios/{name}.yaml", overrides)
-    except ScenarioError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
-    try:
-        result = run_study(
-            scenarios,
-            steps,
-            args.out,
-            workers=args.workers,
-            address=args.address,
-            fresh=args.fresh,
-            overrides=overrides,
-        )
-    except OSError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print(
-            f"\ninterrupted: finished runs are kept in {args.out / 'runs'}; "
-            "the same command reuses them",
-            file=sys.stderr,
-        )
-        return 130
+        return str(err)
+    return None
+
+
+def _checked_overrides(settings: list[str], scenarios: list[str]) -> list:
+    """The --set pairs, each scenario parsed with them (ScenarioError on a bad one)."""
+    overrides = [parse_set(text) for text in settings]
+    for name in scenarios:
+        path = SCENARIO_DIR / f"{name}.yaml"
+        parse_scenario(path.read_text(), f"scenarios/{name}.yaml", overrides)
+    return overrides
+
+
+def _print_result(result: StudyResult, docs: Path | None) -> None:
+    """The files written (copied into docs if given) and the study's summary line."""
     for path in result.files:
         print(f"wrote {path}")
-    if args.docs is not None:
-        args.docs.mkdir(parents=True, exist_ok=True)
+    if docs is not None:
+        docs.mkdir(parents=True, exist_ok=True)
         for path in result.files[1:]:
-            shutil.copy2(path, args.docs / path.name)
-            print(f"copied {path.name} to {args.docs}")
+            shutil.copy2(path, docs / path.name)
+            print(f"copied {path.name} to {docs}")
     n = len(result.records)
     work = (
         f"{result.computed} simulated in {result.wall_s / 60:.1f} min, {result.reused} reused"
@@ -165,4 +184,3 @@ def main(
         else "no step passes for every scenario"
     )
     print(f"convergence: {n} runs ({work}), {passed} within issue 11's bounds; {chosen}")
-    return 0

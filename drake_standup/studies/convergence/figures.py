@@ -27,7 +27,6 @@ def draw_figure(records: list[dict], path: Path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
 
     scenarios = list(dict.fromkeys(r["scenario"] for r in records))
     colors = {s: f"C{i}" for i, s in enumerate(scenarios)}
@@ -71,15 +70,7 @@ def draw_figure(records: list[dict], path: Path) -> None:
 
     for ax, (key, title) in zip(axes, PANELS):
         plot(ax, lambda r, key=key: r["normalised"][key], log=True)
-        ax.set_yscale("log")
-        # Up to the ceiling only where an event happened in one run only.
-        values = [r["normalised"][key] for r in records if not r.get("reference")]
-        top = max([v for v in values if v is not None] + [3.0])
-        top = CEILING * 1.4 if math.isinf(top) else min(2.0 * top, CEILING * 1.4)
-        ax.set_ylim(FLOOR * 0.7, top)
-        ax.axhline(1.0, color="red", ls="--", lw=1)
-        ax.axhspan(1.0, top, color="red", alpha=0.05)
-        ax.set_title(title, fontsize=10)
+        _bound_panel(ax, records, key, title)
     ax = axes[6]
     plot(ax, lambda r: r["errors"]["extra_crossings"], log=False)
     ax.axhline(0.0, color="red", ls="--", lw=1)
@@ -89,6 +80,28 @@ def draw_figure(records: list[dict], path: Path) -> None:
     ax.axhline(1.0, color="gray", ls=":", lw=1)
     ax.set_title("speed: simulated s / wall s", fontsize=10)
     ax.set_ylim(bottom=0)
+    _step_axes(axes, steps)
+    _legend_and_note(fig, scenarios, colors)
+    fig.tight_layout(rect=(0, 0.02, 1, 0.95))
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _bound_panel(ax, records: list[dict], key: str, title: str) -> None:
+    """An error panel's log y axis, its bound (1) shaded beyond, and its title."""
+    ax.set_yscale("log")
+    # Up to the ceiling only where an event happened in one run only.
+    values = [r["normalised"][key] for r in records if not r.get("reference")]
+    top = max([v for v in values if v is not None] + [3.0])
+    top = CEILING * 1.4 if math.isinf(top) else min(2.0 * top, CEILING * 1.4)
+    ax.set_ylim(FLOOR * 0.7, top)
+    ax.axhline(1.0, color="red", ls="--", lw=1)
+    ax.axhspan(1.0, top, color="red", alpha=0.05)
+    ax.set_title(title, fontsize=10)
+
+
+def _step_axes(axes, steps: list[float]) -> None:
+    """The plant steps on every panel's log x axis, labelled on the bottom row."""
     for ax in axes:
         ax.set_xscale("log")
         ax.set_xticks(steps)
@@ -97,6 +110,13 @@ def draw_figure(records: list[dict], path: Path) -> None:
         ax.grid(alpha=0.3, which="both")
     for ax in axes[4:]:
         ax.set_xlabel("plant step (ms)")
+
+
+def _legend_and_note(fig, scenarios: list[str], colors: dict[str, str]) -> None:
+    """The legend (scenarios, controller periods, bound) on top, what the axes' ends mean
+    below."""
+    from matplotlib.lines import Line2D
+
     handles = [Line2D([], [], color=colors[s], marker="o", label=s) for s in scenarios]
     handles += [
         Line2D([], [], color="k", marker="o", label="controller at the plant step"),
@@ -114,6 +134,3 @@ def draw_figure(records: list[dict], path: Path) -> None:
         fontsize=8,
         color="0.3",
     )
-    fig.tight_layout(rect=(0, 0.02, 1, 0.95))
-    fig.savefig(path, dpi=110)
-    plt.close(fig)

@@ -57,47 +57,7 @@ def markdown(
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     refs = {r["scenario"]: r for r in records if r.get("reference")}
-    for r in records:
-        raw, err = r["raw"], r["errors"]
-        ref = refs.get(r["scenario"])
-        ref_cross = _crossings_total(ref["raw"]["contact_crossings"]) if ref else None
-        cross = _crossings_total(raw["contact_crossings"])
-        reason = raw["failure_reason"] or "?"
-        stood = (
-            "yes" if raw["success"] else ("no" if reason == "did not stand up" else f"no: {reason}")
-        )
-        if r.get("reference"):
-            mark = "ref"
-        elif r.get("fine"):
-            mark = "finer"
-        elif not r["pass"]:
-            mark = "**no**: " + ", ".join(r["failed"])
-        elif r["strict_pass"]:
-            mark = "yes"
-        else:
-            mark = "yes (" + ", ".join(r["strict_failed"]) + ")"
-        fine = r.get("errors_vs_fine", {})
-        if r.get("reference"):
-            fine = next(
-                (
-                    q["reference_errors_vs_fine"]
-                    for q in records
-                    if q["scenario"] == r["scenario"] and "reference_errors_vs_fine" in q
-                ),
-                {},
-            )
-        lines.append(
-            f"| {r['scenario']} | {r['step_ms']:g} / {r['controller_period_ms']:g} | {stood} | "
-            f"{fmt(raw['standup_time_s'])} | {fmt(err['standup_time_s'], digits=3)} | "
-            f"{fmt(err['state_entries_s'], digits=3)} | {fmt(err['com_deviation_m'], 1e3, 1)} | "
-            f"{fmt(fine.get('com_deviation_m'), 1e3, 1)} | "
-            f"{fmt(err['com_final_m'], 1e3, 1)} | {fmt(err['pad_split_pct'], digits=1)} | "
-            f"{fmt(fine.get('pad_split_pct'), digits=1)} | "
-            f"{fmt(err['peak_torque_rel'], 100.0, 1)} | "
-            f"{'-' if cross is None else cross} ({'-' if ref_cross is None else ref_cross}) | "
-            f"{raw['qp_failures']} | {fmt(raw['realtime_factor'])} | "
-            f"{fmt(raw['wall_time_s'], digits=0)} | {mark} |"
-        )
+    lines += [_run_row(r, refs, records) for r in records]
     lines += [
         "",
         "| plant / ctrl (ms) | every scenario passes | strictly (vs 1 ms only) | failing | "
@@ -117,6 +77,52 @@ def markdown(
     if wall_s is not None:
         lines.append(f"Study wall time: {wall_s / 60:.1f} min.")
     return "\n".join(lines) + "\n"
+
+
+def _run_row(r: dict, refs: dict[str, dict], records: list[dict]) -> str:
+    """The per-run table's row of run r; refs: each scenario's reference run."""
+    raw, err = r["raw"], r["errors"]
+    ref = refs.get(r["scenario"])
+    ref_cross = _crossings_total(ref["raw"]["contact_crossings"]) if ref else None
+    cross = _crossings_total(raw["contact_crossings"])
+    reason = raw["failure_reason"] or "?"
+    stood = "yes" if raw["success"] else ("no" if reason == "did not stand up" else f"no: {reason}")
+    mark = _verdict(r)
+    fine = r.get("errors_vs_fine", {})
+    if r.get("reference"):
+        fine = next(
+            (
+                q["reference_errors_vs_fine"]
+                for q in records
+                if q["scenario"] == r["scenario"] and "reference_errors_vs_fine" in q
+            ),
+            {},
+        )
+    return (
+        f"| {r['scenario']} | {r['step_ms']:g} / {r['controller_period_ms']:g} | {stood} | "
+        f"{fmt(raw['standup_time_s'])} | {fmt(err['standup_time_s'], digits=3)} | "
+        f"{fmt(err['state_entries_s'], digits=3)} | {fmt(err['com_deviation_m'], 1e3, 1)} | "
+        f"{fmt(fine.get('com_deviation_m'), 1e3, 1)} | "
+        f"{fmt(err['com_final_m'], 1e3, 1)} | {fmt(err['pad_split_pct'], digits=1)} | "
+        f"{fmt(fine.get('pad_split_pct'), digits=1)} | "
+        f"{fmt(err['peak_torque_rel'], 100.0, 1)} | "
+        f"{'-' if cross is None else cross} ({'-' if ref_cross is None else ref_cross}) | "
+        f"{raw['qp_failures']} | {fmt(raw['realtime_factor'])} | "
+        f"{fmt(raw['wall_time_s'], digits=0)} | {mark} |"
+    )
+
+
+def _verdict(r: dict) -> str:
+    """The pass column of run r."""
+    if r.get("reference"):
+        return "ref"
+    if r.get("fine"):
+        return "finer"
+    if not r["pass"]:
+        return "**no**: " + ", ".join(r["failed"])
+    if r["strict_pass"]:
+        return "yes"
+    return "yes (" + ", ".join(r["strict_failed"]) + ")"
 
 
 def choice_sentence(choice: dict | None, records: list[dict]) -> str:

@@ -84,24 +84,7 @@ def run_study(
 
     t0 = time.perf_counter()
     if todo:
-        tasks = [
-            (
-                c,
-                f"convergence-{c.name}-{inputs[c]['hash']}",
-                run_case,
-                (
-                    texts[c.scenario],
-                    f"scenarios/{c.scenario}.yaml",
-                    c.step_s,
-                    c.controller_period_s,
-                    durations[c.scenario],
-                    str((runs_dir / c.name).resolve()),
-                    inputs[c],
-                    list(overrides),
-                ),
-            )
-            for c in todo
-        ]
+        tasks = _tasks(todo, texts, durations, inputs, runs_dir, overrides)
         run_on_cluster(
             tasks,
             on_result,
@@ -118,7 +101,56 @@ def run_study(
         record["inputs"] = inputs[case]
         record["reused"] = case not in todo
     choice = choose(records, scenarios)
-    study = {
+    study = _study(records, choice, scenarios, steps_ms, durations, overrides, wall_s, todo, cases)
+    files = [out_dir / "convergence.json", out_dir / "convergence.md", out_dir / "convergence.png"]
+    write_json(files[0], _inf_as_text(study))
+    files[1].write_text(markdown(records, choice, wall_s if todo else None, overrides))
+    draw_figure(records, files[2])
+    return StudyResult(records, choice, len(todo), len(cases) - len(todo), wall_s, files)
+
+
+def _tasks(
+    todo: list[Case],
+    texts: dict[str, str],
+    durations: dict[str, float],
+    inputs: dict[Case, dict],
+    runs_dir: Path,
+    overrides: list | tuple,
+) -> list[tuple]:
+    """run_on_cluster's tasks: (case, key, run_case, its arguments) of each case to run."""
+    return [
+        (
+            c,
+            f"convergence-{c.name}-{inputs[c]['hash']}",
+            run_case,
+            (
+                texts[c.scenario],
+                f"scenarios/{c.scenario}.yaml",
+                c.step_s,
+                c.controller_period_s,
+                durations[c.scenario],
+                str((runs_dir / c.name).resolve()),
+                inputs[c],
+                list(overrides),
+            ),
+        )
+        for c in todo
+    ]
+
+
+def _study(
+    records: list[dict],
+    choice: dict | None,
+    scenarios: list[str],
+    steps_ms: list[float],
+    durations: dict[str, float],
+    overrides: list | tuple,
+    wall_s: float,
+    todo: list[Case],
+    cases: list[Case],
+) -> dict:
+    """convergence.json's content: the bounds, the study's inputs, the choice and every run."""
+    return {
         "issue": 11,
         "bounds": {
             "standup_time_rel": STANDUP_TIME_REL,
@@ -140,11 +172,6 @@ def run_study(
         "reused": len(cases) - len(todo),
         "runs": records,
     }
-    files = [out_dir / "convergence.json", out_dir / "convergence.md", out_dir / "convergence.png"]
-    write_json(files[0], _inf_as_text(study))
-    files[1].write_text(markdown(records, choice, wall_s if todo else None, overrides))
-    draw_figure(records, files[2])
-    return StudyResult(records, choice, len(todo), len(cases) - len(todo), wall_s, files)
 
 
 def _inf_as_text(x):

@@ -1,0 +1,409 @@
+"""The stand-up's mode and its transitions, as the phase table declares them: pure
+functions on an immutable StandupMode (state_machine.py wraps them in a Drake system).
+
+What each state does and the guard that leaves it are the phase table's (phases.py);
+this module is its mechanism:
+
+- update_guards: the forces the guards read, low-pass filtered (first order,
+  standup.force_filter_time_constant_s), through Schmitt triggers: a condition turns on
+  once its filtered force has stayed above the threshold for guard_dwell_s, and off once
+  it has stayed below guard_off_ratio times the threshold as long, so noise around a
+  threshold cannot flip it back and forth.
+- next_mode: one update. A phase is left for the next one when every condition of its
+  Guard holds and no pull against the stand-up has been felt for standup.resume_after_s;
+  one switch per update at most, so no state is ever skipped. "Segment done" (psi past
+  the segment's end) keeps the reference's slope continuous across switches.
+- seat_loads: what is left of each seat pad's load while the phases release it (NaN
+  while the pad is seated): the contact schedule's input (contact_schedule.py).
+- A pull against the stand-up (both hands together pulled backwards by more than
+  standup.hindering_force_threshold_N, through the same filter and trigger) is answered
+  by the phase's when_hindered: wait (the guards wait for calm), sit_back (_sit_back: the
+  reference returns to the seated CoM, state 1 again), step_back (while the pads this
+  phase releases still carry more than reseat_above_thigh_load of their load: sit back;
+  while they unload: back to the previous phase, _step_back; once off: wait) or stand
+  (the standing robot leans against it; not waiting).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from drake_standup.config import StandupConfig
+from drake_standup.config.phases import PHASES, SEAT_PADS, Guard, Phase, PhaseTable
+from drake_standup.standup.com_path import path, smoothstep
+
+N_STATES = len(PHASES)
+_NAN3 = (math.nan, math.nan, math.nan)
+
+
+@dataclass(frozen=True)
+class SchmittTrigger:
+    """A condition with hysteresis and dwell: on after the value has stayed above the on
+    threshold for the dwell, off after it has stayed below the off threshold as long."""
+
+    on: bool = False
+    # Since when the value has been past the threshold that would flip the trigger
+    # (NaN: it is not).
+    pending_since_s: float = math.nan
+
+    def update(
+        self, value: float, t: float, on_above: float, off_below: float, dwell_s: float
+    ) -> SchmittTrigger:
+        crossing = value < off_below if self.on else value > on_above
+        if not crossing:
+            return self if math.isnan(self.pending_since_s) else SchmittTrigger(self.on)
+        since = t if math.isnan(self.pending_since_s) else self.pending_since_s
+        if t - since >= dwell_s - 1e-9:
+            return SchmittTrigger(not self.on)
+        return SchmittTrigger(self.on, since)
+
+
+_OFF = SchmittTrigger()
+
+
+@dataclass(frozen=True)
+class GuardSignals:
+    """Filtered forces and the triggers the guards read; feet_loaded[k] and
+    each_foot_loaded[k] are phase k+1's exit conditions (off where it has none)."""
+
+    t: float = math.nan  # time of the last update (NaN: none yet)
+    foot_fz_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
+    hand_fx_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
+    hands_pulled: SchmittTrigger = _OFF  # both hands > hand_force_threshold_N
+    feet_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # the feet together
+    each_foot_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # each foot
+    # Both hands together pulled backwards (against the stand-up) by more than
+    # hindering_force_threshold_N.
+    hindered: SchmittTrigger = _OFF
+    # A pull needing more than standing_pull_usage_limit of what the standing robot's
+    # feet can hold (filtered usage; the trigger).
+    pull_usage: float = 0.0
+    beyond_feet: SchmittTrigger = _OFF
+
+    def against(self) -> bool:
+        """A pull the stand-up cannot go on under: hindering, or beyond the feet."""
+        return self.hindered.on or self.beyond_feet.on
+
+
+@dataclass(frozen=True)
+class StandupMode:
+    """The machine's abstract state: where it is, the active CoM segment, the guards'
+    filtered signals, and what a pull against the stand-up has done."""
+
+    state: int = 1
+    entry_times_s: tuple[float, ...] = (0.0,) + (math.nan,) * (N_STATES - 1)
+    psi_entry: float = 0.0
+    segment_psi: float = 1.0
+    x_start_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    delta_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    guards: GuardSignals = GuardSignals()
+    held_back_s: float = 0.0  # time spent waiting for a pull against it to stop
+    held_beyond_feet_s: float = 0.0  # of which a pull beyond what the feet can hold
+    # Where the CoM sat at the start: a sit-back returns there, so that the next
+    # forward segment starts where the first one did.
+    x_seated_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    hindered_until_s: float = -math.inf  # the last time a hindering pull was felt
+    # A step back from a phase: where its segment was to end (NaN: none). The phase,
+    # entered again, ends there.
+    resume_end_m: tuple[float, float, float] = _NAN3
+    sat_back: bool = False  # a hindering pull has sat the robot back since the start
+    # When the release of each seat pad group (phases.SEAT_PADS) began (NaN: seated).
+    release_s: tuple[float, ...] = (math.nan,) * len(SEAT_PADS)
+
+    def __copy__(self) -> StandupMode:
+        return self
+
+    def __deepcopy__(self, memo: dict) -> StandupMode:
+        """Itself: the mode is immutable. Drake clones the abstract state (a Python
+        deepcopy) into and out of its scratch state at every unrestricted update of the
+        diagram, i.e. at every plant step: real copies cost ~15 us a step (measured)."""
+        return self
+
+    def segment(self) -> np.ndarray:
+        """[psi_entry, T, x_start, delta] (payloads.SEGMENT)."""
+        return np.array([self.psi_entry, self.segment_psi, *self.x_start_m, *self.delta_m])
+
+    def segment_end(self) -> np.ndarray:
+        return np.array(self.x_start_m) + np.array(self.delta_m)
+
+    def stepped_back(self) -> bool:
+        return not math.isnan(self.resume_end_m[0])
+
+
+@dataclass(frozen=True)
+class Measurements:
+    """What the guards read: time, psi, CoM, heel edge, feet and hand forces."""
+
+    t: float
+    psi: float
+    com_W: np.ndarray
+    heel_x: float
+    foot_fz_N: tuple[float, float]  # left, right
+    hand_fx_N: tuple[float, float]  # left, right
+    # The x of the thigh pads' centres (NaN: not measured; a release waiting for the CoM
+    # to pass them never begins).
+    thigh_x: float = math.nan
+    # sensing.standing_pull_usage of the measured pull (0: not measured).
+    pull_usage: float = 0.0
+    # Someone asked for the stand-up (live mode's "Stand up" button): with
+    # trigger 'hands', as good as the pull.
+    stand_up: bool = False
+
+
+def initial_mode(com0_W: np.ndarray, t: float = 0.0) -> StandupMode:
+    """State 1 at t, holding the CoM where it starts."""
+    com0 = tuple(float(c) for c in com0_W)
+    entry = (t,) + (math.nan,) * (N_STATES - 1)
+    return StandupMode(entry_times_s=entry, x_start_m=com0, x_seated_m=com0)
+
+
+def _low_pass(previous: tuple[float, ...], raw: tuple[float, ...], gain: float) -> tuple:
+    return tuple(float(y + gain * (x - y)) for y, x in zip(previous, raw, strict=True))
+
+
+def update_guards(
+    g: GuardSignals, m: Measurements, cfg: StandupConfig, table: PhaseTable
+) -> GuardSignals:
+    """The guards' signals after a measurement: forces filtered (first order, exact for a
+    step held over the update: gain 1 - exp(-dt / tau); the first measurement starts the
+    filters), then the triggers of every phase's exit."""
+    if math.isnan(g.t):
+        feet, hands, usage = tuple(m.foot_fz_N), tuple(m.hand_fx_N), m.pull_usage
+    else:
+        tau = cfg.force_filter_time_constant_s
+        gain = 1.0 if tau <= 0 else 1.0 - math.exp(-max(m.t - g.t, 0.0) / tau)
+        feet = _low_pass(g.foot_fz_N, m.foot_fz_N, gain)
+        hands = _low_pass(g.hand_fx_N, m.hand_fx_N, gain)
+        (usage,) = _low_pass((g.pull_usage,), (m.pull_usage,), gain)
+    off, dwell = cfg.guard_off_ratio, cfg.guard_dwell_s
+
+    def trigger(trigger: SchmittTrigger, value: float, threshold: float | None):
+        if threshold is None:
+            return trigger
+        return trigger.update(value, m.t, threshold, off * threshold, dwell)
+
+    hand_on, back_on = cfg.hand_force_threshold_N, cfg.hindering_force_threshold_N
+    exits = [phase.exit for phase in table]
+    return GuardSignals(
+        t=m.t,
+        foot_fz_N=feet,
+        hand_fx_N=hands,
+        hands_pulled=g.hands_pulled.update(min(hands), m.t, hand_on, off * hand_on, dwell),
+        feet_loaded=tuple(
+            trigger(k, sum(feet), e.feet_force_N) for k, e in zip(g.feet_loaded, exits)
+        ),
+        each_foot_loaded=tuple(
+            trigger(k, min(feet), e.each_foot_force_N) for k, e in zip(g.each_foot_loaded, exits)
+        ),
+        hindered=g.hindered.update(-sum(hands), m.t, back_on, off * back_on, dwell),
+        pull_usage=usage,
+        beyond_feet=g.beyond_feet.update(
+            usage, m.t, cfg.standing_pull_usage_limit, off * cfg.standing_pull_usage_limit, dwell
+        ),
+    )
+
+
+def next_mode(
+    mode: StandupMode, m: Measurements, cfg: StandupConfig, table: PhaseTable
+) -> StandupMode:
+    """The mode after one update: its guards' signals updated, in the same, the next or
+    (under a pull against the stand-up) an earlier state."""
+    g = update_guards(mode.guards, m, cfg, table)
+    phase = table.phase(mode.state)
+    against = g.against()
+    held, beyond = mode.held_back_s, mode.held_beyond_feet_s
+    if against and phase.when_hindered != "stand" and not math.isnan(mode.guards.t):
+        held += m.t - mode.guards.t
+        if g.beyond_feet.on:
+            beyond += m.t - mode.guards.t
+    hindered_until = m.t if against else mode.hindered_until_s
+    mode = dataclasses.replace(
+        mode,
+        guards=g,
+        held_back_s=held,
+        held_beyond_feet_s=beyond,
+        hindered_until_s=hindered_until,
+    )
+    if against:
+        if phase.when_hindered == "step_back":
+            loads = np.nan_to_num(seat_loads(mode, m.t, table), nan=1.0)  # NaN: seated
+            left = max(loads[_released(phase)], default=0.0)
+            if left > cfg.reseat_above_thigh_load:  # the pads still carry the robot
+                return _sit_back(mode, m, table)
+            if left > 0.0:  # unloading: back onto them
+                return _step_back(mode, m, table)
+        elif phase.when_hindered == "sit_back" and not mode.stepped_back():
+            return _sit_back(mode, m, table)
+    mode = _begin_releases(mode, phase, m)
+    calm = not against and m.t - mode.hindered_until_s >= cfg.resume_after_s
+    if mode.state == N_STATES or not (calm and guard_holds(phase, mode, m, cfg)):
+        return mode
+    return _enter(mode, mode.state + 1, m, table)
+
+
+def _begin_releases(mode: StandupMode, phase: Phase, m: Measurements) -> StandupMode:
+    """The release of the pads phase unloads begins, where it has not yet: at once, or
+    once the CoM has passed the thigh pads by phase.unload_when."""
+    waiting = [
+        k
+        for k, pads in enumerate(SEAT_PADS)
+        if pads in phase.unload and math.isnan(mode.release_s[k])
+    ]
+    if not waiting:
+        return mode
+    if phase.unload_when is not None and not m.com_W[0] >= m.thigh_x + phase.unload_when:
+        return mode
+    release = list(mode.release_s)
+    for k in waiting:
+        release[k] = m.t
+    return dataclasses.replace(mode, release_s=tuple(release))
+
+
+def released_for_s(mode: StandupMode, phase: Phase, t: float) -> float:
+    """How long the release of every pad group phase unloads has been going on at t (inf:
+    it unloads none; NaN: one has not begun)."""
+    since = [t - mode.release_s[k] for k, pads in enumerate(SEAT_PADS) if pads in phase.unload]
+    return math.nan if any(map(math.isnan, since)) else min(since, default=math.inf)
+
+
+def guard_holds(phase: Phase, mode: StandupMode, m: Measurements, cfg: StandupConfig) -> bool:
+    """Every condition of phase.exit (phases.Guard) holds for mode at m."""
+    guard: Guard = phase.exit
+    k = mode.state - 1
+    dwell = m.t - mode.entry_times_s[k]
+    g = mode.guards
+    if dwell < guard.min_time_s:
+        return False
+    if guard.asked and not (cfg.trigger == "time" or g.hands_pulled.on or m.stand_up):
+        return False
+    if guard.segment_done and not (
+        m.psi - mode.psi_entry >= mode.segment_psi or not any(mode.delta_m)
+    ):
+        return False
+    if guard.unloaded and not released_for_s(mode, phase, m.t) >= phase.unload_s:
+        return False
+    if guard.feet_force_N is not None and not g.feet_loaded[k].on:
+        return False
+    if guard.each_foot_force_N is not None and not g.each_foot_loaded[k].on:
+        return False
+    ahead = guard.com_ahead_of_heels_m
+    return ahead is None or m.com_W[0] >= m.heel_x + ahead
+
+
+def _released(phase: Phase) -> list[int]:
+    """The entries of seat_loads that phase releases."""
+    return [i for i, pads in enumerate(SEAT_LOADS) if pads in phase.unload]
+
+
+def _sit_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMode:
+    """Back to state 1: a pull against the stand-up waits seated (the paper: psi = t,
+    nothing advances). The state-1 segment starts where the reference is now (no jump)
+    and returns to where the CoM sat at the start, over phases.seated.segment_psi; state
+    1's balancing time runs again from now, and its exit waits for the return. Held where
+    it was instead, each later forward segment ended its offset further on and the
+    robot stood up past its toes (docs/design.md, "A pull against the stand-up")."""
+    x_now = path(mode.segment(), m.psi)[0]
+    entry = [m.t] + [math.nan] * (N_STATES - 1)
+    return dataclasses.replace(
+        mode,
+        state=1,
+        entry_times_s=tuple(entry),
+        psi_entry=m.psi,
+        segment_psi=table.seated.segment_psi,
+        x_start_m=tuple(float(v) for v in x_now),
+        delta_m=tuple(float(a - b) for a, b in zip(mode.x_seated_m, x_now, strict=True)),
+        resume_end_m=_NAN3,
+        sat_back=True,
+        release_s=(math.nan,) * len(SEAT_PADS),
+    )
+
+
+def _step_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMode:
+    """Back to the previous phase while this one's pads unload: they are seated again
+    (they carry what the chair gives) and the reference stops where it is (psi = t,
+    nothing advances). Once the pull has stopped, the previous phase's guard (calm among
+    them) enters this phase again, whose segment then ends where the interrupted one
+    would have (docs/design.md, "A pull against the stand-up")."""
+    x_now = path(mode.segment(), m.psi)[0]
+    entry = list(mode.entry_times_s)
+    entry[mode.state - 1] = math.nan
+    left = table.phase(mode.state).unload
+    release = [math.nan if pads in left else s for pads, s in zip(SEAT_PADS, mode.release_s)]
+    return dataclasses.replace(
+        mode,
+        release_s=tuple(release),
+        state=mode.state - 1,
+        entry_times_s=tuple(entry),
+        psi_entry=m.psi,
+        segment_psi=1.0,
+        x_start_m=tuple(float(v) for v in x_now),
+        delta_m=(0.0, 0.0, 0.0),
+        resume_end_m=tuple(float(v) for v in mode.segment_end()),
+    )
+
+
+def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) -> StandupMode:
+    """state's phase entered: its segment starts where the previous one ended (that one
+    is done, or holds still), at the CoM's height where the phase says so (bumpless: a
+    stiffer height gain would otherwise see the lean's 1-3 cm drop as a step), toward its
+    displacement, its absolute height, or where a step back left it to end."""
+    phase = table.phase(state)
+    x_start = mode.segment_end()
+    if phase.start_at_com_height:
+        x_start[2] = float(m.com_W[2])
+    delta = np.array(phase.com_delta_m, dtype=float)
+    if phase.com_height_m is not None:
+        delta[2] = phase.com_height_m - x_start[2]
+    if mode.stepped_back():
+        delta[:2] = np.array(mode.resume_end_m[:2]) - x_start[:2]
+    entry = list(mode.entry_times_s)
+    entry[state - 1] = m.t
+    entered = dataclasses.replace(
+        mode,
+        state=state,
+        entry_times_s=tuple(entry),
+        psi_entry=m.psi,
+        segment_psi=phase.segment_psi,
+        x_start_m=tuple(float(v) for v in x_start),
+        delta_m=tuple(float(v) for v in delta),
+        resume_end_m=_NAN3,
+    )
+    return _begin_releases(entered, phase, m)
+
+
+# The seat pads, as seat_loads orders them, and their pad group (phases.SEAT_PADS).
+SEAT_LOADS = ("buttocks", "thighs", "thighs")
+
+
+def seat_releases(table: PhaseTable) -> list[tuple[int, float, list[int], int]]:
+    """(the state that releases it, over how long, s, the entries of SEAT_LOADS, its index
+    in SEAT_PADS) of each pad group the table releases."""
+    releases = []
+    for k, pads in enumerate(SEAT_PADS):
+        state = table.unloading_phase(pads)
+        if state is not None:
+            rows = [i for i, name in enumerate(SEAT_LOADS) if name == pads]
+            releases.append((state, table.phase(state).unload_s, rows, k))
+    return releases
+
+
+def seat_loads(
+    mode: StandupMode, t: float, table: PhaseTable | list[tuple[int, float, list[int]]]
+) -> np.ndarray:
+    """What is left of the load of the buttocks and of each thigh (SEAT_LOADS), as a
+    fraction of their load when their release began; NaN while the pad is seated. A pad
+    group is released from mode.release_s (in the phase that lists it in unload, at its
+    entry or once its unload_when holds; until the robot is back in an earlier phase),
+    smoothstep from 1 to 0 over its unload_s. table: the phase table, or its
+    seat_releases."""
+    releases = seat_releases(table) if isinstance(table, PhaseTable) else table
+    loads = np.full(len(SEAT_LOADS), math.nan)
+    for _, over_s, rows, k in releases:
+        began = mode.release_s[k]
+        if not math.isnan(began):
+            loads[rows] = 0.0 if over_s <= 0 else smoothstep(1.0 - (t - began) / over_s)
+    return loads
