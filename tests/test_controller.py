@@ -28,12 +28,12 @@ from drake_standup.control.qp import as_slice
 from drake_standup.control.terms import RobotKinematics
 from drake_standup.standup.contact_schedule import contact_commands, phase_seat_hold
 from drake_standup.standup.task_references import (
+    PhaseReferences,
     ReferenceGenerator,
-    StandupSchedule,
-    TaskReferenceGenerator,
     helpful_force,
 )
 from drake_standup.standup.transitions import initial_mode
+from drake_standup.standup.whole_body import StandupWholeBodyController
 from drake_standup.world.scene import add_scene, set_seated_state
 
 G = 9.81
@@ -56,9 +56,20 @@ PERIOD_S = 0.001
 NO_PULL = np.zeros(12)
 
 
+class _FixedSchedule:
+    """A contact schedule that answers every tick with the commands the rig fixed."""
+
+    def __init__(self):
+        self.commands = None
+
+    def tick(self, mode, t, memory, commanded_N, measured_N):
+        return self.commands, memory.copy()
+
+
 class _Rig:
-    """The controller's model, the task references and the whole-body controller wired
-    as in the stand-up controller, their inputs fixed: one tick from given inputs."""
+    """The stand-up's whole-body controller system (the controller's model, the task
+    references and the QP, one tick) with its inputs and contact commands fixed: one
+    tick from given inputs."""
 
     def __init__(self, scene, **config):
         """config: ControllerConfig's fields; the nominal model (no weighing) unless
@@ -69,71 +80,54 @@ class _Rig:
         self.specs = contact_specs(plant, robot, self.config)
         joints = ControllerJoints.of(plant, robot)
         g = -plant.gravity_field().gravity_vector()[2]
-        schedule = StandupSchedule(
+        schedule = PhaseReferences(
             self.table, self.config, joints.names, joints.q_min, joints.q_max
         )
-        builder = DiagramBuilder()
-        model = builder.AddSystem(ControllerModel(plant, robot, self.specs, self.config, PERIOD_S))
-        references = builder.AddSystem(
-            TaskReferenceGenerator(
-                ReferenceGenerator(self.config, schedule, as_slice(joints.q_indices), PERIOD_S, g),
-                PERIOD_S,
-            )
+        self.schedule = _FixedSchedule()
+        self.controller = WholeBodyController(
+            plant,
+            self.specs,
+            joints,
+            self.config,
+            modes=(1, 2, 3, 4),
+            stance_modes={k for k, phase in enumerate(self.table, start=1) if phase.stance},
         )
-        self.controller = builder.AddSystem(
-            WholeBodyController(plant, self.specs, joints, self.config, self.table, PERIOD_S)
+        self.system = StandupWholeBodyController(
+            self.schedule,
+            ControllerModel(plant, robot, self.specs, self.config, PERIOD_S),
+            ReferenceGenerator(self.config, schedule, as_slice(joints.q_indices), PERIOD_S, g),
+            self.controller,
+            plant.num_multibody_states(robot.model_instance),
+            PERIOD_S,
         )
-        builder.Connect(model.GetOutputPort("terms"), references.GetInputPort("terms"))
-        builder.Connect(model.GetOutputPort("terms"), self.controller.GetInputPort("terms"))
-        builder.Connect(
-            references.GetOutputPort("task_references"),
-            self.controller.GetInputPort("task_references"),
-        )
-        for name, systems in {
-            "robot_state": (model,),
-            "hand_wrenches_W": (model, references),
-            "pads_vertical_force_N": (model,),
-            "standup_state": (model, references),
-            "contact_commands": (model, self.controller),
-            "com_reference": (references,),
-            "path_progress": (references,),
-            "response": (references,),
-        }.items():
-            builder.ExportInput(systems[0].GetInputPort(name), name)
-            for system in systems[1:]:
-                builder.ConnectInput(name, system.GetInputPort(name))
-        self.diagram = builder.Build()
-        self.context = self.diagram.CreateDefaultContext()
-        self.controller_context = self.controller.GetMyContextFromRoot(self.context)
+        self.context = self.system.CreateDefaultContext()
 
     def fix(self, x, com_reference, standup_state, hands=NO_PULL, loads=None):
         """Inputs of a tick in standup_state with the seat pads' loads (seat_loads: None,
         every pad seated; released ones from 100 N)."""
         loads = np.full(3, math.nan) if loads is None else np.asarray(loads, dtype=float)
         mode = dataclasses.replace(initial_mode(np.zeros(3)), state=standup_state)
-        commands = contact_commands(
+        self.schedule.commands = contact_commands(
             self.config, loads, np.full(3, 100.0), None, phase_seat_hold(mode, self.table)
         )
         inputs = {
             "robot_state": x,
+            "seat_pad_normal_forces_N": np.zeros(3),
             "hand_wrenches_W": hands,
             "pads_vertical_force_N": [0.0],
-            "standup_state": [standup_state],
             "com_reference": com_reference,
             "path_progress": [1.0],
             "response": [0.0],  # advancement's: the help let through
         }
         for name, value in inputs.items():
-            self.diagram.GetInputPort(name).FixValue(self.context, value)
-        self.diagram.GetInputPort("contact_commands").FixValue(
-            self.context, Value[object](commands)
-        )
+            self.system.GetInputPort(name).FixValue(self.context, value)
+        self.system.GetInputPort("mode").FixValue(self.context, Value[object](mode))
 
     def tick(self):
-        return self.controller.CalcTick(self.controller_context).solution
+        return self.system.calc_tick(self.context)[0].solution
 
     def diagnostics(self) -> dict[str, float]:
-        values = self.controller.GetOutputPort("diagnostics").Eval(self.controller_context)
+        values = self.system.GetOutputPort("diagnostics").Eval(self.context)
         return {
             name: part[0] for name, part in DIAGNOSTICS.unpack(values).items() if len(part) == 1
         }
@@ -517,16 +511,16 @@ def _infeasible_ticks(scene, break_fallback: bool):
     com = _com(plant, robot.model_instance, x0)
     rig.fix(x0, np.concatenate([com, np.zeros(6)]), 1)
     last = np.linspace(-1.0, 1.0, plant.num_actuators())
-    rig.controller_context.get_mutable_discrete_state(0).SetFromVector(last)
+    rig.context.get_mutable_discrete_state(rig.system.actuation_state).SetFromVector(last)
     if break_fallback:
         # Build the program the ticks use, then make its fallback fail.
         rig.tick()
         program = rig.controller.program((True,) * len(CONTACTS))
         program.qp._solve_relaxed = lambda H, g: (np.full(len(g), np.nan), False)
-    simulator = Simulator(rig.diagram, rig.context)
+    simulator = Simulator(rig.system, rig.context)
     simulator.Initialize()  # the initialization update
     simulator.AdvanceTo(0.0025)  # periodic updates at 0, 1 and 2 ms
-    actuation = rig.controller.GetOutputPort("actuation").Eval(rig.controller_context)
+    actuation = rig.system.GetOutputPort("actuation").Eval(rig.context)
     return last, actuation, rig.diagnostics()
 
 
@@ -615,16 +609,25 @@ def _solution_in_state(scene, x, reference, standup_state):
 
 
 def test_ports_and_config(scene):
-    """The ports the stand-up controller wires (control/controller.py's docstring); the
+    """The ports the stand-up controller wires (standup/whole_body.py's docstring); the
     config loads from YAML typed."""
     scene, _ = scene
     rig = _Rig(scene)
-    controller, plant = rig.controller, scene.plant
-    inputs = [controller.get_input_port(i).get_name() for i in range(controller.num_input_ports())]
-    assert inputs == ["terms", "task_references", "contact_commands"]
-    assert controller.GetOutputPort("actuation").size() == plant.num_actuators()
-    assert controller.GetOutputPort("diagnostics").size() == DIAGNOSTICS.size
-    assert controller.GetOutputPort("commanded_normal_forces_N").size() == len(CONTACTS)
+    system, plant = rig.system, scene.plant
+    inputs = [system.get_input_port(i).get_name() for i in range(system.num_input_ports())]
+    assert inputs == [
+        "robot_state",
+        "seat_pad_normal_forces_N",
+        "pads_vertical_force_N",
+        "hand_wrenches_W",
+        "com_reference",
+        "path_progress",
+        "response",
+        "mode",
+    ]
+    assert system.GetOutputPort("actuation").size() == plant.num_actuators()
+    assert system.GetOutputPort("diagnostics").size() == DIAGNOSTICS.size
+    assert [system.GetOutputPort(name).size() for name in ("lean_W", "compliance_W")] == [3, 6]
     config = yaml_load_typed(
         schema=ControllerConfig, data="qp_solver: clarabel\nposture_weight: 0.5\n"
     )

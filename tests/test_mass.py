@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from pydrake.common.value import Value
-from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import ControllerConfig, Scenario
@@ -58,33 +56,24 @@ def test_the_controllers_model_weighs_the_seated_robot():
     plant, robot = scene.plant, scene.robot
     config = ControllerConfig()
     model = ControllerModel(plant, robot, contact_specs(plant, robot, config), config, 0.004)
-    context = model.CreateDefaultContext()
     plant_context = plant.CreateDefaultContext()
     set_seated_state(scene, plant_context, scenario)
     m = plant.CalcTotalMass(plant_context, [robot.model_instance])
     g = -plant.gravity_field().gravity_vector()[2]
     hands = np.zeros(12)
     hands[5] = hands[11] = 10.0
-    fixed = {
-        "robot_state": plant.GetPositionsAndVelocities(plant_context, robot.model_instance),
-        "hand_wrenches_W": hands,
-        "pads_vertical_force_N": [1.08 * m * g],
-        "standup_state": [1.0],
-    }
-    for name, value in fixed.items():
-        model.GetInputPort(name).FixValue(context, value)
-    seated = contact_commands(config, np.full(3, np.nan), np.zeros(3), None, "held")
-    model.GetInputPort("contact_commands").FixValue(context, Value[object](seated))
-    simulator = Simulator(model, context)
-    simulator.AdvanceTo(1.0)
-    target = 1.08 + 20.0 / (m * g)
+    weighing = np.array(ControllerModel.INITIAL_WEIGHING)
     ticks = 1 + int(round(1.0 / 0.004))  # the initialization tick, then one per period
+    for _ in range(ticks):
+        weighing = model.next_weighing(weighing, 1, hands, 1.08 * m * g)
+    target = 1.08 + 20.0 / (m * g)
     expected = target - (target - 1.0) * (1.0 - 0.004 / 0.3) ** ticks
-    estimate = model.GetOutputPort("mass_estimate").Eval(context)[0]
+    estimate = weighing[0]
     assert estimate == pytest.approx(expected, abs=RESCALE_ABOVE)
-    terms = model.GetOutputPort("terms").Eval(context)
+    seated = contact_commands(config, np.full(3, np.nan), np.zeros(3), None, "held")
+    x = plant.GetPositionsAndVelocities(plant_context, robot.model_instance)
+    terms = model.terms(x, seated, hands, float(weighing[2]))
     assert terms.mass_kg == pytest.approx(expected * m, rel=2 * RESCALE_ABOVE)
-    model.GetInputPort("standup_state").FixValue(context, [2.0])
-    model.GetInputPort("pads_vertical_force_N").FixValue(context, [0.5 * m * g])
-    simulator.AdvanceTo(2.0)
-    assert model.GetOutputPort("mass_estimate").Eval(context)[0] == estimate
+    for _ in range(ticks):
+        weighing = model.next_weighing(weighing, 2, hands, 0.5 * m * g)
+    assert weighing[0] == estimate

@@ -7,14 +7,12 @@ import math
 
 import numpy as np
 import pytest
-from pydrake.common.value import Value
-from pydrake.systems.analysis import Simulator
 
 from drake_standup.config import ControllerConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.standup.contact_schedule import (
     CONTACTS,
-    ContactScheduler,
+    ContactSchedule,
     contact_commands,
     next_unload_from,
     phase_seat_hold,
@@ -122,28 +120,19 @@ PERIOD_S = 2.0**-7
 
 
 class _Schedule:
-    """The ContactScheduler alone, its inputs fixed by hand."""
+    """The ContactSchedule alone, its memory kept here as the controller keeps it."""
 
     def __init__(self):
-        self.system = ContactScheduler(CONFIG, TABLE, period_s=PERIOD_S)
-        self.context = self.system.CreateDefaultContext()
-        self.simulator = Simulator(self.system, self.context)
-        self.system.GetInputPort("seat_pad_normal_forces_N").FixValue(self.context, [1e3] * 3)
-        self.system.GetInputPort("mode").FixValue(
-            self.context, Value[object](initial_mode(np.zeros(3)))
-        )
-        self.system.GetInputPort("commanded_normal_forces_N").FixValue(self.context, np.zeros(5))
-        self.simulator.Initialize()
+        self.schedule = ContactSchedule(CONFIG, TABLE)
+        self.memory = np.zeros(ContactSchedule.MEMORY_SIZE)
+        self.tick(0.0, initial_mode(np.zeros(3)), np.zeros(5))  # the initialization tick
 
     def tick(self, t: float, mode, commanded) -> object:
-        """The commands of the tick at t (what the controller reads then) with mode and
-        commanded as inputs, and that tick's update (Drake handles an event at t at the
-        start of the step after t)."""
-        self.system.GetInputPort("mode").FixValue(self.context, Value[object](mode))
-        self.system.GetInputPort("commanded_normal_forces_N").FixValue(self.context, commanded)
-        self.simulator.AdvanceTo(t)
-        commands = self.system.GetOutputPort("contact_commands").Eval(self.context)
-        self.simulator.AdvanceTo(t + 1e-9)
+        """The commands of the tick at t with mode and commanded (what the controller's
+        last tick asked), the memory updated as after that tick."""
+        commands, self.memory = self.schedule.tick(
+            mode, t, self.memory, commanded, lambda: np.full(3, 1e3)
+        )
         return commands
 
 

@@ -1,37 +1,26 @@
 """WholeBodyController: the momentum-based whole-body torque controller (SPEC 2, 3, 7).
 
-A thin LeafSystem: every period_s it reads the controller's model at the robot's state
-(terms, control/model.py), the tick's task references (control/references.py) and the
-contact commands (control/schedule.py), solves one QP over [contact wrenches, vdot] with
-the task objects of control/tasks.py (control/qp.py) and holds the joint torques. On a
-failed QP the last torques stay.
-
-Ports
-    terms               abstract RobotTerms
-    task_references     abstract TaskReferences
-    contact_commands    abstract ContactCommands
-    -> actuation        (nu) joint torques, actuator order, N m (zero-order held)
-    -> diagnostics      DIAGNOSTICS
-    -> commanded_normal_forces_N (5) DIAGNOSTICS' commanded_normal_force_N
+A plain object: each tick, from the controller's model at the robot's state (RobotTerms,
+control/model.py), the tick's task references (TaskReferences, control/targets.py) and
+the contact commands (ContactCommands, control/contacts.py), it solves one QP over
+[contact wrenches, vdot] with the task objects of control/tasks.py (control/qp.py) for
+the joint torques. The system that holds the torques and calls it once a tick is the
+stand-up's (standup/standup_controller.py); on a failed QP the last torques stay there.
+next_diagnostics packs a tick's DIAGNOSTICS.
 
 One QP program per set of active contacts (its size, and so its solve time, shrinks once
 the seat is released), built at the first tick that needs it (make_program); the tasks
-active in each stand-up state come from the phase table (the stance tasks where a phase
-has stance).
+active in each mode are the caller's to say (the stance tasks in the stance modes).
 """
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.common.value import Value
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.systems.framework import BasicVector, Context, DiscreteValues, LeafSystem
 
 from drake_standup.config import ControllerConfig
-from drake_standup.config.phases import PhaseTable
 from drake_standup.control.contacts import (
     CONTACTS,
     HOLDS,
@@ -43,7 +32,7 @@ from drake_standup.control.contacts import (
 )
 from drake_standup.control.model import ControllerJoints
 from drake_standup.control.qp import ContactMap, QpContactBounds, QpSolution, WholeBodyQp
-from drake_standup.control.targets import joint_values
+from drake_standup.control.targets import TaskReferences, joint_values
 from drake_standup.control.tasks import (
     BaseOrientationTask,
     CopCenteringTask,
@@ -52,6 +41,7 @@ from drake_standup.control.tasks import (
     PostureTask,
     StancePostureTask,
 )
+from drake_standup.control.terms import RobotTerms
 from drake_standup.ports.payloads import VectorLayout
 
 DIAGNOSTICS = VectorLayout(
@@ -202,8 +192,9 @@ class ControllerTick:
     assembly_s: float  # the QP's tasks and matrices
 
 
-class WholeBodyController(LeafSystem):
-    """Momentum-based whole-body torque controller (module docstring)."""
+class WholeBodyController:
+    """Momentum-based whole-body torque controller (module docstring): a plain object
+    whose solve() the stand-up controller's tick calls (standup/standup_controller.py)."""
 
     def __init__(
         self,
@@ -211,41 +202,25 @@ class WholeBodyController(LeafSystem):
         specs: list[ContactSpec],
         joints: ControllerJoints,
         config: ControllerConfig,
-        table: PhaseTable,
-        period_s: float,
+        modes: tuple[int, ...],
+        stance_modes: set[int],
     ):
-        super().__init__()
+        """modes: the values TaskReferences.standup_state takes; stance_modes: those in
+        which the stance tasks act."""
         if [spec.frame for spec in specs] != list(CONTACTS):
             raise ValueError(f"contact specs must be {CONTACTS}")
         actuators = plant.GetJointActuatorIndices()
+        self.num_actuators = len(actuators)
         torque_limit = config.torque_limit_Nm or min(
             plant.get_joint_actuator(i).effort_limit() for i in actuators
         )
-        stance = {k for k, phase in enumerate(table, start=1) if phase.stance}
-        modes = tuple(k for k, _ in enumerate(table, start=1))
         self._make = lambda active: make_program(
-            specs, active, plant, joints, config, stance, torque_limit, modes
+            specs, active, plant, joints, config, set(stance_modes), torque_limit, tuple(modes)
         )
         self._programs: dict[tuple[bool, ...], Program] = {}
         # The last contact commands and the program's form of them.
         self._last: tuple[ContactCommands | None, QpContactBounds | None] = (None, None)
         self._timing: list[tuple[float, ...]] = []
-        self._terms = self.DeclareAbstractInputPort("terms", Value[object](None))
-        self._references = self.DeclareAbstractInputPort("task_references", Value[object](None))
-        self._commands = self.DeclareAbstractInputPort("contact_commands", Value[object](None))
-        self._actuation = self.DeclareDiscreteState(len(actuators))
-        self._diagnostics = self.DeclareDiscreteState(DIAGNOSTICS.size)
-        self.DeclareStateOutputPort("actuation", self._actuation)
-        self.DeclareStateOutputPort("diagnostics", self._diagnostics)
-        self.DeclareVectorOutputPort(
-            "commanded_normal_forces_N",
-            len(CONTACTS),
-            self._CalcCommanded,
-            prerequisites_of_calc={self.discrete_state_ticket(self._diagnostics)},
-        )
-        # Initialization event: the plant's first step already sees computed torques.
-        self.DeclareInitializationDiscreteUpdateEvent(self._Update)
-        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
 
     def timing_s(self) -> np.ndarray:
         """Per-tick compute times since construction (or reset_timing), (ticks, 5), in
@@ -255,6 +230,11 @@ class WholeBodyController(LeafSystem):
     def reset_timing(self) -> None:
         self._timing.clear()
 
+    def record_timing(self, tick: ControllerTick, total_s: float) -> None:
+        self._timing.append(
+            (tick.inputs_s, tick.kinematics_s, tick.assembly_s, tick.solution.solve_s, total_s)
+        )
+
     def program(self, active: tuple[bool, ...]) -> Program:
         """The QP over the active contacts (built when first needed)."""
         program = self._programs.get(active)
@@ -262,14 +242,15 @@ class WholeBodyController(LeafSystem):
             program = self._programs[active] = self._make(active)
         return program
 
-    def CalcTick(self, context: Context) -> ControllerTick:
-        """Solves the QP for the inputs in context."""
-        t_start = time.perf_counter()
-        terms = self._terms.Eval(context)
-        t_terms = time.perf_counter()
-        references = self._references.Eval(context)
-        commands: ContactCommands = self._commands.Eval(context)
-        t_inputs = time.perf_counter()
+    def solve(
+        self,
+        terms: RobotTerms,
+        references: TaskReferences,
+        commands: ContactCommands,
+        inputs_s: float = 0.0,
+        kinematics_s: float = 0.0,
+    ) -> ControllerTick:
+        """This tick's QP; inputs_s, kinematics_s: what making its inputs took."""
         program = self.program(commands.active)
         index = program.contact_index
         if commands is not self._last[0]:  # the schedule's constant commands repeat
@@ -287,36 +268,22 @@ class WholeBodyController(LeafSystem):
         return ControllerTick(
             solution=solution,
             normal_forces_N=normal_forces_N,
-            inputs_s=t_inputs - t_terms,
-            kinematics_s=t_terms - t_start,
+            inputs_s=inputs_s,
+            kinematics_s=kinematics_s,
             assembly_s=solution.assembly_s,
         )
 
-    def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
-        t_start = time.perf_counter()
-        tick = self.CalcTick(context)
-        solution = tick.solution
-        if solution.ok:  # on failure the last torques stay in the actuation state
-            discrete_state.set_value(self._actuation, solution.tau)
-        before = context.get_discrete_state(self._diagnostics).value()
-        total_s = time.perf_counter() - t_start
-        discrete_state.set_value(
-            self._diagnostics,
-            DIAGNOSTICS.pack(
-                qp_ok=float(solution.ok),
-                qp_failures=before[_FAILURES] + (0.0 if solution.ok else 1.0),
-                solve_time_s=solution.solve_s,
-                tick_time_s=total_s,
-                commanded_normal_force_N=tick.normal_forces_N if solution.ok else np.nan,
-                joint_limit_slack=float(np.abs(solution.slack).max())
-                if solution.slack.size
-                else 0.0,
-                qp_relaxed=before[_RELAXED] + float(solution.relaxed),
-            ),
-        )
-        self._timing.append(
-            (tick.inputs_s, tick.kinematics_s, tick.assembly_s, solution.solve_s, total_s)
-        )
 
-    def _CalcCommanded(self, context: Context, output: BasicVector) -> None:
-        output.SetFromVector(context.get_discrete_state(self._diagnostics).value()[_COMMANDED])
+def next_diagnostics(before: np.ndarray, tick: ControllerTick, total_s: float) -> np.ndarray:
+    """DIAGNOSTICS after tick, from those before it (the failure and relaxation counts
+    carry on)."""
+    solution = tick.solution
+    return DIAGNOSTICS.pack(
+        qp_ok=float(solution.ok),
+        qp_failures=before[_FAILURES] + (0.0 if solution.ok else 1.0),
+        solve_time_s=solution.solve_s,
+        tick_time_s=total_s,
+        commanded_normal_force_N=tick.normal_forces_N if solution.ok else np.nan,
+        joint_limit_slack=float(np.abs(solution.slack).max()) if solution.slack.size else 0.0,
+        qp_relaxed=before[_RELAXED] + float(solution.relaxed),
+    )

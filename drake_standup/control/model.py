@@ -1,6 +1,6 @@
 """The controller's model of the robot: its contacts, its joints, and ControllerModel.
 
-ControllerModel's output, RobotTerms (control/terms.py: M, h, the CoM and the centroidal
+ControllerModel's terms, RobotTerms (control/terms.py: M, h, the CoM and the centroidal
 momentum, the contact frames' and the hands' Jacobians), is what the task references and
 the whole-body QP both read, so the dynamics are computed once a tick and both see the
 same numbers. Only the frames a tick needs are computed: the active contacts' (the
@@ -13,15 +13,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.common.value import Value
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.systems.framework import BasicVector, Context, DiscreteValues, LeafSystem
 
 from drake_standup.config import ControllerConfig
 from drake_standup.control.contacts import CONTACTS, ContactCommands, ContactSpec
 from drake_standup.control.mass import next_mass_state
 from drake_standup.control.terms import RobotKinematics, RobotTerms
-from drake_standup.ports.caching import declare_cached
 from drake_standup.ports.payloads import HAND_WRENCHES
 from drake_standup.robot.icub import Robot, actuated_joints
 
@@ -95,16 +92,15 @@ def active_frames(specs: list[ContactSpec], active: tuple[bool, ...]) -> list[st
     return [spec.frame for spec, on in zip(specs, active, strict=True) if on]
 
 
-class ControllerModel(LeafSystem):
-    """The controller's model at the robot's state, once a tick, and its weighing.
+class ControllerModel:
+    """The controller's model at the robot's state, once a tick, and its weighing: a
+    plain object the stand-up controller's tick calls (standup/standup_controller.py).
 
-    Inputs robot_state ([q; v]), contact_commands (abstract ContactCommands),
-    hand_wrenches_W (12, payloads.HAND_WRENCHES), pads_vertical_force_N (1: the vertical
-    force on all the robot's pads), standup_state (1). Outputs terms (abstract
-    RobotTerms) and mass_estimate (1: the mass estimate after the last tick, for
-    logging). Discrete state: the mass estimate's [estimate, began, model's scale]
-    (control/mass.py: next_mass_state), updated every period_s.
+    The weighing is [estimate, began, model's scale] (control/mass.py: next_mass_state);
+    its state lives in the calling system, from INITIAL_WEIGHING.
     """
+
+    INITIAL_WEIGHING = (1.0, 0.0, 1.0)
 
     def __init__(
         self,
@@ -114,7 +110,6 @@ class ControllerModel(LeafSystem):
         config: ControllerConfig,
         period_s: float,
     ):
-        super().__init__()
         if [spec.frame for spec in specs] != list(CONTACTS):
             raise ValueError(f"contact specs must be {CONTACTS}")
         self.specs = specs
@@ -132,57 +127,34 @@ class ControllerModel(LeafSystem):
             min(period_s / filter_s, 1.0) if filter_s > 0.0 else 0.0,
             tuple(config.mass_scale_bounds),
         )
-        nx = plant.num_positions(robot.model_instance) + plant.num_velocities(robot.model_instance)
-        self._state = self.DeclareVectorInputPort("robot_state", nx)
-        self._commands = self.DeclareAbstractInputPort("contact_commands", Value[object](None))
-        self._hands = self.DeclareVectorInputPort("hand_wrenches_W", HAND_WRENCHES.size)
-        self._support = self.DeclareVectorInputPort("pads_vertical_force_N", 1)
-        self._standup_state = self.DeclareVectorInputPort("standup_state", 1)
-        self._weighing = self.DeclareDiscreteState(np.array([1.0, 0.0, 1.0]))
         self._frames: dict[tuple[bool, ...], list[str]] = {}
-        self._next_mass = declare_cached(
-            self, "mass state", self._calc_mass, {self.all_sources_ticket()}
-        )
-        terms = declare_cached(self, "terms", self._calc, {self.all_sources_ticket()})
-        self.DeclareAbstractOutputPort(
-            "terms", lambda: Value[object](None), self._output(terms), {terms.ticket()}
-        )
-        self.DeclareVectorOutputPort(
-            "mass_estimate",
-            1,
-            self._CalcEstimate,
-            prerequisites_of_calc={self.discrete_state_ticket(self._weighing)},
-        )
-        self.DeclareInitializationDiscreteUpdateEvent(self._Update)
-        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
 
-    @staticmethod
-    def _output(entry):
-        def calc(context: Context, output: Value) -> None:
-            output.set_value(entry.Eval(context))
+    def next_weighing(
+        self,
+        weighing: np.ndarray,
+        standup_state: int,
+        hand_wrenches_W: np.ndarray,
+        pads_vertical_force_N: float,
+    ) -> np.ndarray:
+        """The weighing after this tick: the pads' and the hands' vertical forces carry
+        the weight while seated; frozen once the stand-up has begun."""
+        if weighing[1]:
+            return weighing.copy()
+        weight_N = pads_vertical_force_N + hand_wrenches_W[_F_Z_LEFT] + hand_wrenches_W[_F_Z_RIGHT]
+        return next_mass_state(weighing, standup_state, weight_N, *self._mass)
 
-        return calc
-
-    def _calc_mass(self, context: Context) -> np.ndarray:
-        state = context.get_discrete_state(self._weighing).value()
-        if state[1]:  # the stand-up has begun: frozen
-            return state.copy()
-        hands = self._hands.Eval(context)
-        weight_N = float(self._support.Eval(context)[0]) + hands[_F_Z_LEFT] + hands[_F_Z_RIGHT]
-        standup_state = min(max(int(round(self._standup_state.Eval(context)[0])), 1), 4)
-        return next_mass_state(state, standup_state, weight_N, *self._mass)
-
-    def _calc(self, context: Context) -> RobotTerms:
-        self.kinematics.set_mass_scale(float(self._next_mass.Eval(context)[2]))
-        commands: ContactCommands = self._commands.Eval(context)
+    def terms(
+        self,
+        robot_state: np.ndarray,
+        commands: ContactCommands,
+        hand_wrenches_W: np.ndarray,
+        mass_scale: float,
+    ) -> RobotTerms:
+        """RobotTerms at robot_state ([q; v]) for the commands' active contacts, and the
+        hands while they are pulled, with every mass scaled by mass_scale."""
+        self.kinematics.set_mass_scale(mass_scale)
         frames = self._frames.get(commands.active)
         if frames is None:
             frames = self._frames[commands.active] = active_frames(self.specs, commands.active)
-        pulled = bool(self._hands.Eval(context).any())
-        return self.kinematics.calc(self._state.Eval(context), frames, HANDS if pulled else ())
-
-    def _CalcEstimate(self, context: Context, output: BasicVector) -> None:
-        output.SetAtIndex(0, context.get_discrete_state(self._weighing).GetAtIndex(0))
-
-    def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
-        discrete_state.set_value(self._weighing, self._next_mass.Eval(context))
+        pulled = bool(hand_wrenches_W.any())
+        return self.kinematics.calc(robot_state, frames, HANDS if pulled else ())

@@ -25,15 +25,13 @@ the seat holds no rows once the buttocks release: docs/design.md, "Contacts".
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
-from pydrake.common.value import Value
-from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
 from drake_standup.config import ControllerConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.control.contacts import CHAIR, CONTACTS, HOLDS, SOLES, ContactCommands
-from drake_standup.ports.caching import declare_cached
 from drake_standup.standup.transitions import StandupMode, seat_loads, seat_releases
 
 
@@ -91,19 +89,18 @@ def phase_seat_hold(mode: StandupMode, table: PhaseTable) -> str:
     return phase.seat_hold_sat_back if mode.sat_back else phase.seat_hold
 
 
-class ContactScheduler(LeafSystem):
-    """ContactCommands for the whole-body controller, every period_s.
+class ContactSchedule:
+    """ContactCommands for the whole-body controller, once a tick: a plain object the
+    stand-up controller's tick calls (standup/standup_controller.py).
 
-    Inputs: mode (abstract StandupMode, the state machine's), seat_pad_normal_forces_N
-    (3: buttocks, left and right thigh pad, measured),
-    commanded_normal_forces_N (5: what the controller's last tick asked of CONTACTS, NaN
-    where its QP failed). Output: contact_commands (abstract ContactCommands).
-    Discrete state: [the loads the seat pads' release starts from (3), the controller's
-    last successful commands to them (3)], N.
+    Its memory, kept by the caller (MEMORY_SIZE, zero at the start): [the loads the seat
+    pads' release starts from (3), the controller's last successful commands to them
+    (3)], N.
     """
 
-    def __init__(self, config: ControllerConfig, table: PhaseTable, period_s: float):
-        super().__init__()
+    MEMORY_SIZE = 6
+
+    def __init__(self, config: ControllerConfig, table: PhaseTable):
         self._config = config
         self._table = table
         self._releases = seat_releases(table)
@@ -115,51 +112,28 @@ class ContactScheduler(LeafSystem):
         }
         self._released = contact_commands(config, np.zeros(3), np.zeros(3), None, "free")
         self._first_release = min((release[0] for release in self._releases), default=math.inf)
-        self._mode = self.DeclareAbstractInputPort("mode", Value[object](StandupMode()))
-        self._measured = self.DeclareVectorInputPort("seat_pad_normal_forces_N", 3)
-        self._commanded = self.DeclareVectorInputPort("commanded_normal_forces_N", len(CONTACTS))
-        self._memory = self.DeclareDiscreteState(6)
-        # This tick's commands and the memory after it, computed once for both.
-        self._next = declare_cached(
-            self,
-            "commands and next memory",
-            self._tick,
-            {
-                self._mode.ticket(),
-                self._measured.ticket(),
-                self._commanded.ticket(),
-                self.discrete_state_ticket(self._memory),
-                self.time_ticket(),
-            },
-        )
-        self.DeclareAbstractOutputPort(
-            "contact_commands",
-            lambda: Value[object](None),
-            self._CalcCommands,
-            {self._next.ticket()},
-        )
-        self.DeclareInitializationDiscreteUpdateEvent(self._Update)
-        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
 
-    def _tick(self, context: Context) -> tuple[ContactCommands, np.ndarray]:
-        memory = context.get_discrete_state(self._memory).value()
-        mode = self._mode.Eval(context)
-        commanded = self._commanded.Eval(context)[CHAIR]
+    def tick(
+        self,
+        mode: StandupMode,
+        t: float,
+        memory: np.ndarray,
+        commanded_N: np.ndarray,
+        measured_N: Callable[[], np.ndarray],
+    ) -> tuple[ContactCommands, np.ndarray]:
+        """(this tick's commands, the memory after it). mode: the state machine's;
+        commanded_N: what the controller's last tick asked of CONTACTS (NaN where its QP
+        failed); measured_N(): the seat pads' normal forces (3: buttocks, left and right
+        thigh pad), read only while a pad releases."""
+        commanded = commanded_N[CHAIR]
         last = commanded if np.isfinite(commanded).all() else memory[3:]
         if mode.state < self._first_release:  # every pad seated: following its commands
             return self._seated[phase_seat_hold(mode, self._table)], np.concatenate((last, last))
-        loads = seat_loads(mode, context.get_time(), self._releases)
+        loads = seat_loads(mode, t, self._releases)
         if not loads.any():  # every pad released (NaN, seated, counts as nonzero)
             return self._released, np.concatenate((memory[:3], last))
         unload_from = next_unload_from(memory[:3], last, loads)
-        measured = self._measured.Eval(context)
         commands = contact_commands(
-            self._config, loads, unload_from, measured, phase_seat_hold(mode, self._table)
+            self._config, loads, unload_from, measured_N(), phase_seat_hold(mode, self._table)
         )
         return commands, np.concatenate((unload_from, last))
-
-    def _CalcCommands(self, context: Context, output: Value) -> None:
-        output.set_value(self._next.Eval(context)[0])
-
-    def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
-        discrete_state.set_value(self._memory, self._next.Eval(context)[1])

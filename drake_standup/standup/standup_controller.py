@@ -1,16 +1,19 @@
-"""make_standup_controller(scenario, station, plan): the stand-up controller, as one diagram.
+"""make_standup_controller(scenario, station, plan): the stand-up controller, as one diagram
+of the systems of the paper: the state machine, the psi integrator, the CoM reference
+generator and the whole-body controller.
 
-    state machine ──mode──► contact schedule ──commands──┬──► controller model ──terms──┐
-       │ state, segment, advances                        │   (weighs the robot seated)  │
-       ▼                                                 │                              ▼
-    advancement ◄──► CoM reference ──com_reference──► task references ──► whole-body controller
-                     (psi, x_d(psi))                                 commands ──┘  │ torques
+    state machine ──mode──────────────────────────────────────────┐
+       │ state, segment, advances                                  ▼
+    advancement ◄──► CoM reference ──com_reference, progress──► whole-body controller
+    (psi)            (x_d(psi))                                   (contact schedule, model,
+                                                                   task references, QP) │ torques
 
-The state machine (state_machine.py) follows the phase table (phases.py); the
-advancement (advancement.py) integrates psi; the CoM reference (com_path.py) is x_d(psi)
-and its derivatives; the contact schedule (contact_schedule.py), the controller's model
-with its mass estimate (control/model.py, control/mass.py) and the task references
-(task_references.py) feed the whole-body QP (control/controller.py).
+The state machine (state_machine.py) follows the phase table (config/phases.py); the
+advancement (advancement.py) integrates psi as continuous state; the CoM reference
+(com_path.py) is x_d(psi) and its derivatives; the whole-body controller (whole_body.py)
+runs the contact schedule (contact_schedule.py), the controller's model with its mass
+estimate (control/model.py), the task references (task_references.py) and the QP
+(control/controller.py) as plain objects, in one tick.
 
 Inputs (a station's outputs of the same names, station.py): robot_state, pad_forces_W,
 seat_pad_normal_forces_N, pads_vertical_force_N, hand_wrenches_W (measured), com_W,
@@ -36,14 +39,11 @@ from drake_standup.control.model import ControllerJoints, ControllerModel, conta
 from drake_standup.control.qp import as_slice
 from drake_standup.standup.advancement import TrajectoryAdvancement
 from drake_standup.standup.com_path import CoMReferenceGenerator
-from drake_standup.standup.contact_schedule import ContactScheduler
+from drake_standup.standup.contact_schedule import ContactSchedule
 from drake_standup.standup.plan import StandupPlan
 from drake_standup.standup.state_machine import StandupStateMachine
-from drake_standup.standup.task_references import (
-    ReferenceGenerator,
-    StandupSchedule,
-    TaskReferenceGenerator,
-)
+from drake_standup.standup.task_references import PhaseReferences, ReferenceGenerator
+from drake_standup.standup.whole_body import StandupWholeBodyController
 from drake_standup.world.sensing import standing_lean
 from drake_standup.world.station import Station
 
@@ -68,24 +68,15 @@ _WIRES = [
     ("com_reference", "psi_dot", "advancement", "psi_dot"),
     ("com_reference", "psi_ddot", "advancement", "psi_ddot"),
     ("com_reference", "segment", "state_machine", "segment"),
-    ("contact_schedule", "mode", "state_machine", "mode"),
-    ("contact_schedule", "seat_pad_normal_forces_N", "", "seat_pad_normal_forces_N"),
-    ("contact_schedule", "commanded_normal_forces_N", "controller", "commanded_normal_forces_N"),
-    ("controller_model", "robot_state", "", "robot_state"),
-    ("controller_model", "pads_vertical_force_N", "", "pads_vertical_force_N"),
-    ("controller_model", "standup_state", "state_machine", "standup_state"),
-    ("controller_model", "contact_commands", "contact_schedule", "contact_commands"),
-    ("controller_model", "hand_wrenches_W", "", "hand_wrenches_W"),
-    ("task_references", "terms", "controller_model", "terms"),
-    ("task_references", "standup_state", "state_machine", "standup_state"),
-    ("task_references", "com_reference", "com_reference", "com_reference"),
-    ("task_references", "hand_wrenches_W", "", "hand_wrenches_W"),
-    ("task_references", "path_progress", "com_reference", "path_progress"),
-    ("task_references", "response", "", "response"),
+    ("controller", "mode", "state_machine", "mode"),
+    ("controller", "robot_state", "", "robot_state"),
+    ("controller", "seat_pad_normal_forces_N", "", "seat_pad_normal_forces_N"),
+    ("controller", "pads_vertical_force_N", "", "pads_vertical_force_N"),
+    ("controller", "hand_wrenches_W", "", "hand_wrenches_W"),
+    ("controller", "com_reference", "com_reference", "com_reference"),
+    ("controller", "path_progress", "com_reference", "path_progress"),
+    ("controller", "response", "", "response"),
     ("advancement", "response", "", "response"),
-    ("controller", "terms", "controller_model", "terms"),
-    ("controller", "task_references", "task_references", "task_references"),
-    ("controller", "contact_commands", "contact_schedule", "contact_commands"),
 ]
 # The diagram's outputs: name -> (system, its output).
 _OUTPUTS = {
@@ -100,9 +91,9 @@ _OUTPUTS = {
     "held_back": ("state_machine", "held_back"),
     "segment": ("state_machine", "segment"),
     "entry_times_s": ("state_machine", "entry_times_s"),
-    "lean_W": ("task_references", "lean_W"),
-    "compliance_W": ("task_references", "compliance_W"),
-    "mass_estimate": ("controller_model", "mass_estimate"),
+    "lean_W": ("controller", "lean_W"),
+    "compliance_W": ("controller", "compliance_W"),
+    "mass_estimate": ("controller", "mass_estimate"),
 }
 
 
@@ -122,16 +113,16 @@ def make_standup_controller(
     g = -plant.gravity_field().gravity_vector()[2]
     specs = contact_specs(plant, robot, config)
     joints = ControllerJoints.of(plant, robot)
-    schedule = StandupSchedule(table, config, joints.names, joints.q_min, joints.q_max)
+    schedule = PhaseReferences(table, config, joints.names, joints.q_min, joints.q_max)
     systems = {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()
         ),
         "advancement": TrajectoryAdvancement(scenario.advancement),
         "com_reference": CoMReferenceGenerator(),
-        "contact_schedule": ContactScheduler(config, table, period_s),
-        "controller_model": ControllerModel(plant, robot, specs, config, period_s),
-        "task_references": TaskReferenceGenerator(
+        "controller": StandupWholeBodyController(
+            ContactSchedule(config, table),
+            ControllerModel(plant, robot, specs, config, period_s),
             ReferenceGenerator(
                 config,
                 schedule,
@@ -142,9 +133,17 @@ def make_standup_controller(
                 partial(standing_lean, support=station.standing),
                 scenario.standup.standing_pull_usage_limit,
             ),
+            WholeBodyController(
+                plant,
+                specs,
+                joints,
+                config,
+                modes=tuple(range(1, plan.n_states + 1)),
+                stance_modes={k for k, phase in enumerate(table, start=1) if phase.stance},
+            ),
+            plant.num_multibody_states(robot.model_instance),
             period_s,
         ),
-        "controller": WholeBodyController(plant, specs, joints, config, table, period_s),
     }
     builder = DiagramBuilder()
     for name, system in systems.items():
@@ -163,4 +162,4 @@ def make_standup_controller(
         builder.ExportOutput(systems[system].GetOutputPort(port), name)
     diagram = builder.Build()
     diagram.set_name("standup_controller")
-    return StandupController(diagram, systems["controller"])
+    return StandupController(diagram, systems["controller"].controller)

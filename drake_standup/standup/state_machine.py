@@ -16,7 +16,7 @@ from pydrake.common.value import Value
 from pydrake.systems.framework import BasicVector, Context, LeafSystem, State
 
 from drake_standup.config import StandupConfig
-from drake_standup.config.phases import SEAT_PADS, PhaseTable
+from drake_standup.config.phases import PhaseTable
 from drake_standup.ports.payloads import SEGMENT
 from drake_standup.standup.transitions import (
     N_STATES,
@@ -24,7 +24,6 @@ from drake_standup.standup.transitions import (
     StandupMode,
     initial_mode,
     next_mode,
-    seat_loads,
 )
 
 
@@ -83,12 +82,6 @@ class StandupStateMachine(LeafSystem):
         }
         for name, (size, calc) in vectors.items():
             self.DeclareVectorOutputPort(name, size, calc, prerequisites_of_calc=mode_only)
-        self.DeclareVectorOutputPort(
-            "contact_plan",
-            6,
-            self._CalcContactPlan,
-            prerequisites_of_calc=mode_only | {self.time_ticket()},
-        )
 
     def mode(self, context: Context) -> StandupMode:
         return context.get_abstract_state(self._mode_index).get_value()
@@ -144,19 +137,6 @@ class StandupStateMachine(LeafSystem):
                 mode.held_beyond_feet_s,
             ]
         )
-
-    def _CalcContactPlan(self, context: Context, output: BasicVector) -> None:
-        mode = self.mode(context)
-        t = context.get_time()
-        loads = seat_loads(mode, t, self._table)
-        k = self._table.unloading_phase("thighs")
-        began = mode.release_s[SEAT_PADS.index("thighs")]
-        if math.isnan(began):
-            scale = 1.0
-        else:
-            over = self._table.phase(k).unload_s
-            scale = 0.0 if over <= 0 else max(0.0, 1.0 - (t - began) / over)
-        output.SetFromVector(np.r_[mode.state, scale, 1.0, loads])
 
     def _CalcEntryTimes(self, context: Context, output: BasicVector) -> None:
         output.SetFromVector(np.array(self.mode(context).entry_times_s))

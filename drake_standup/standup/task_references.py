@@ -1,6 +1,6 @@
 """What the tasks track: the per-state schedule and each tick's references (SPEC 3, 7).
 
-StandupSchedule is the one place for what changes with the standup state (defaults of
+PhaseReferences is the one place for what changes with the standup state (defaults of
 ControllerConfig):
 
     state   CoM K_P            posture target               base pitch   seat
@@ -50,16 +50,12 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-from pydrake.common.value import Value
-from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
 from drake_standup.config import RESPONSES, ComplianceConfig, ControllerConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.control.spatial import yaw_pitch_rotation
 from drake_standup.control.targets import StateReferences, TaskReferences, joint_values
 from drake_standup.control.terms import RobotTerms
-from drake_standup.ports.caching import declare_cached
-from drake_standup.ports.payloads import COM_REFERENCE, HAND_WRENCHES
 from drake_standup.robot.balance import static_lean
 from drake_standup.standup.com_path import smoothstep
 
@@ -103,7 +99,7 @@ def helpful_force(
     return fade * max(float(f_hand_W @ u), 0.0) * u
 
 
-class StandupSchedule:
+class PhaseReferences:
     """StateReferences of states 1-4 from the phase table (phases.py)."""
 
     def __init__(
@@ -143,7 +139,7 @@ class ReferenceGenerator:
     def __init__(
         self,
         config: ControllerConfig,
-        schedule: StandupSchedule,
+        schedule: PhaseReferences,
         q_joints: slice | np.ndarray,
         period_s: float,
         gravity_mps2: float = 0.0,
@@ -390,78 +386,3 @@ class ReferenceGenerator:
             next_momentum_integral=momentum_integral + self._period_s * terms.L_WCom[:3],
             next_posture=np.concatenate((self._latched, q_initial, q_next, (base_yaw,))),
         )
-
-
-class TaskReferenceGenerator(LeafSystem):
-    """Each tick's TaskReferences (ReferenceGenerator.calc) as a system, every period_s.
-
-    Inputs: terms (abstract RobotTerms, control/model.py), standup_state (1),
-    com_reference (9, payloads.COM_REFERENCE), hand_wrenches_W (12), path_progress (1:
-    how far along its segment the CoM reference is, 0-1), response (1: the response code,
-    ADVANCEMENT, STIFF or COMPLIANT). Outputs: task_references (abstract TaskReferences),
-    lean_W (3: the CoM target's lean after the last tick, m) and compliance_W (6: the
-    admittance's offset and rate after the last tick, m, m/s). Discrete state: the angular
-    momentum's integral (3, N m s^2), the posture state (TaskReferences.next_posture), the
-    lean (3, m), the stance's height integral (1, m s), the admittance (6).
-    """
-
-    def __init__(self, generator: ReferenceGenerator, period_s: float):
-        super().__init__()
-        self._generator = generator
-        self._period_s = period_s
-        nu = len(generator.schedule.q_target_min)
-        self._terms = self.DeclareAbstractInputPort("terms", Value[object](None))
-        self._state_input = self.DeclareVectorInputPort("standup_state", 1)
-        self._reference = self.DeclareVectorInputPort("com_reference", COM_REFERENCE.size)
-        self._hands = self.DeclareVectorInputPort("hand_wrenches_W", HAND_WRENCHES.size)
-        self._progress = self.DeclareVectorInputPort("path_progress", 1)
-        self._response = self.DeclareVectorInputPort("response", 1)
-        self._integral = self.DeclareDiscreteState(3)
-        # [latched flag, state-1 posture (nu), filtered posture reference (nu), base yaw].
-        self._posture = self.DeclareDiscreteState(2 + 2 * nu)
-        self._lean = self.DeclareDiscreteState(3)
-        self._height_integral = self.DeclareDiscreteState(1)
-        self._compliance = self.DeclareDiscreteState(6)
-        self._references = declare_cached(
-            self, "task references", self._calc, {self.all_sources_ticket()}
-        )
-        self.DeclareAbstractOutputPort(
-            "task_references",
-            lambda: Value[object](None),
-            self._CalcReferences,
-            {self._references.ticket()},
-        )
-        self.DeclareStateOutputPort("lean_W", self._lean)
-        self.DeclareStateOutputPort("compliance_W", self._compliance)
-        self.DeclareInitializationDiscreteUpdateEvent(self._Update)
-        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
-
-    def _calc(self, context: Context) -> TaskReferences:
-        state = context.get_discrete_state()
-        F_hand_W = self._hands.Eval(context)
-        progress = float(self._progress.Eval(context)[0])
-        standup_state = min(max(int(round(self._state_input.Eval(context)[0])), 1), 4)
-        return self._generator.calc(
-            self._terms.Eval(context),
-            standup_state,
-            self._reference.Eval(context),
-            F_hand_W if F_hand_W.any() else None,
-            state.get_value(self._integral),
-            state.get_value(self._posture),
-            state.get_value(self._lean),
-            progress,
-            float(state.get_value(self._height_integral)[0]),
-            int(round(self._response.Eval(context)[0])),
-            state.get_value(self._compliance),
-        )
-
-    def _CalcReferences(self, context: Context, output: Value) -> None:
-        output.set_value(self._references.Eval(context))
-
-    def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
-        references = self._references.Eval(context)
-        discrete_state.set_value(self._integral, references.next_momentum_integral)
-        discrete_state.set_value(self._posture, references.next_posture)
-        discrete_state.set_value(self._lean, references.lean_W)
-        discrete_state.set_value(self._height_integral, [references.next_height_integral])
-        discrete_state.set_value(self._compliance, references.next_compliance)
