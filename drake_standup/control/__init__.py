@@ -12,8 +12,10 @@
     tasks.py       Task objects (centroidal momentum, CoP centering, posture, base
                    orientation), each with its weight, active modes and update(), and
                    the joint-limit acceleration bounds
+    qp_types.py    the QP's types: the unknowns' layout, the contact map, the task and
+                   bound protocols, the contact plan's bounds, the solution
     qp.py          the one QP over [contact wrenches, vdot], which consumes any list of
-                   tasks, and its solver backends
+                   tasks, and its solver backends (WholeBodyQp)
     controller.py  WholeBodyController, the thin LeafSystem: terms + task references +
                    contact commands -> torques; adding a task is adding an object to its
                    list (make_program), not editing the QP

@@ -41,160 +41,27 @@ The joints kept are those whose row was in play at the last tick (at a bound or 
 """
 
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from functools import cached_property
-from typing import Protocol
 
 import numpy as np
 
 from drake_standup.control.backends import make_backend
-from drake_standup.control.contacts import WRENCH_SIZE, ContactSpec, wrench_cone_matrix
+from drake_standup.control.contacts import WRENCH_SIZE, wrench_cone_matrix
+
+# Other modules and the tests import the QP's types from here too (QpLayout only for them).
+from drake_standup.control.qp_types import (
+    AccelerationBounds,
+    ActiveTasks,
+    ContactMap,
+    QpContactBounds,
+    QpSolution,
+    Task,
+    as_slice,
+)
+from drake_standup.control.qp_types import QpLayout as QpLayout
 from drake_standup.control.targets import TaskReferences
 from drake_standup.control.terms import RobotTerms
 
 N_BASE = 6  # unactuated floating-base velocities
-
-
-class QpLayout:
-    """Where each unknown sits in z = [F_1 .. F_nc, vdot]; F_c has wrench_sizes[c] entries
-    (6, or 3 for a point contact)."""
-
-    def __init__(self, wrench_sizes: tuple[int, ...], nv: int):
-        self.wrench_sizes = tuple(wrench_sizes)
-        self.nv = nv
-        self.n_wrench = sum(self.wrench_sizes)
-        self.n = self.n_wrench + nv
-        starts = np.cumsum((0,) + self.wrench_sizes)
-        self._wrench = [slice(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
-        self.wrenches = slice(0, self.n_wrench)
-        self.vdot = slice(self.n_wrench, self.n)
-
-    @classmethod
-    def of(cls, contacts: list[ContactSpec], nv: int) -> "QpLayout":
-        return cls(tuple(spec.size for spec in contacts), nv)
-
-    def wrench(self, c: int) -> slice:
-        return self._wrench[c]
-
-
-class Task:
-    """One least-squares objective, w ||A z[columns] - b||^2 (w: weight, a scalar or one
-    weight per row of A), in the modes active_states (None: every mode; control/tasks.py).
-
-    A task sets weight, columns, A and b when it is made and refreshes what changes in
-    update(), each tick it is active. constant_A: A never changes, so the QP adds w A^T A
-    to its Hessian once per set of active tasks; constant_b: neither does b."""
-
-    name: str
-    weight: float | np.ndarray
-    columns: slice
-    A: np.ndarray  # (rows, width of columns)
-    b: np.ndarray  # (rows,)
-    active_states: frozenset[int] | None = None
-    constant_A: bool = False
-    constant_b: bool = False
-
-    def update(self, terms: RobotTerms, references: TaskReferences) -> None:
-        """Refreshes A and/or b for the tick (a constant task has nothing to do)."""
-
-
-class AccelerationBounds(Protocol):
-    """Bounds vdot_min <= vdot[v_indices] <= vdot_max that change with the state
-    (control/tasks.py: JointLimitBounds)."""
-
-    v_indices: np.ndarray
-
-    def calc(self, terms: RobotTerms) -> tuple[np.ndarray, np.ndarray]:
-        """(vdot_min, vdot_max) at terms' state."""
-
-
-@dataclass
-class QpContactBounds:
-    """What the contact plan asks of the program's contacts this tick (in its order)."""
-
-    min_normal_force_N: np.ndarray  # (nc,)
-    max_normal_force_N: np.ndarray  # (nc,)
-    # Constrained contacts that hold only some rows of their hold point's spatial
-    # acceleration, in C ([alpha; a]): contact index -> held rows; the others hold all.
-    partially_held: dict[int, np.ndarray]
-
-
-@dataclass
-class QpSolution:
-    """A tick's solution; on failure (ok False) its numbers are not to be used."""
-
-    frames: list[str]  # the contacts' task frames, in the order of F_C and F_W
-    ok: bool
-    vdot: np.ndarray  # (nv,)
-    F_C: np.ndarray  # (nc, 6) each contact's wrench in its frame, [tau; f], N m / N
-    tau: np.ndarray  # (nu,) joint torques, actuator order, N m
-    assembly_s: float
-    solve_s: float
-    frame_rotations: Callable[[], np.ndarray]  # () -> the contact frames' R_WC (nc, 3, 3)
-    slack: np.ndarray = field(default_factory=lambda: np.zeros(0))  # soft bounds' s
-    # Solved only with the contacts relaxed (WholeBodyQp._solve_relaxed): the torques are
-    # the best the program could do, not a command that keeps the contacts.
-    relaxed: bool = False
-
-    @cached_property
-    def F_W(self) -> np.ndarray:
-        """(nc, 6) F_C at each contact frame's origin, in W (computed when asked for: the
-        controller does not need the frames' poses)."""
-        nc = len(self.frames)
-        # [tau; f] in C -> W, all contacts at once: (nc, 3, 3) @ (nc, 3, 2).
-        R_WC = self.frame_rotations()
-        F_W = (R_WC @ self.F_C.reshape(nc, 2, 3).transpose(0, 2, 1)).transpose(0, 2, 1)
-        return F_W.reshape(nc, WRENCH_SIZE)
-
-
-def as_slice(indices: np.ndarray) -> slice | np.ndarray:
-    """indices as a slice when they are consecutive (a view instead of a copy)."""
-    indices = np.asarray(indices)
-    if len(indices) and np.array_equal(indices, np.arange(indices[0], indices[0] + len(indices))):
-        return slice(int(indices[0]), int(indices[0]) + len(indices))
-    return indices
-
-
-class ContactMap:
-    """G^T (n_wrench, nv), G_c = J_c^T X_c: the contact unknowns to generalized forces
-    (X_c: the unknowns of contact c to its 6-D wrench at Co, in W): the rows of the
-    contacts' Jacobians expressed in their own frames (control/terms.py) that act on the
-    unknowns. Its first six columns map them to their resultant about the base origin, in
-    W. Shared by the QP and the tasks that need it, computed once per terms."""
-
-    def __init__(self, contacts: list[ContactSpec], nv: int):
-        self.contacts = list(contacts)
-        self.layout = QpLayout.of(contacts, nv)
-        # The unknowns' rows among each contact's 6-D wrench [tau; f] (f_z last): rows of
-        # the contacts' stacked Jacobians (nc * 6, nv).
-        self.unknowns = np.concatenate(
-            [
-                WRENCH_SIZE * c + np.arange(WRENCH_SIZE)[spec.components]
-                for c, spec in enumerate(contacts)
-            ]
-        )
-        self._GT: np.ndarray | None = None
-        self._terms: RobotTerms | None = None
-
-    def __call__(self, terms: RobotTerms) -> np.ndarray:
-        """G^T for terms, which holds the contact frames in this map's order."""
-        if self._terms is not terms:
-            self._GT = terms.J_F.reshape(-1, self.layout.nv)[self.unknowns]
-            self._terms = terms
-        return self._GT
-
-
-@dataclass
-class _ActiveTasks:
-    """The tasks active in a set of standup states and what the QP precomputes of them."""
-
-    updated: list[Task]  # the ones with an update() to call
-    varying: list[Task]  # A changes: w A^T A and w A^T b each tick
-    # A constant, b not: (task, -w A^T); their Hessian blocks are in H_fixed.
-    tracking: list[tuple[Task, np.ndarray]]
-    H_fixed: np.ndarray  # regularisation + w A^T A of the constant-A tasks
-    g_fixed: np.ndarray | None  # -w A^T b of the constant tasks (None: zero)
 
 
 class WholeBodyQp:
@@ -228,9 +95,9 @@ class WholeBodyQp:
         (each task is active in its active_states of them). acceleration_bounds: bounds on
         entries of vdot, computed each tick (None: none). soft_bounds: bounds that a slack
         s per entry may move, vdot_min <= vdot - s <= vdot_max, at the cost
-        soft_bound_weight s^2 (at the
-        optimum |s| is the violation; one two-sided row per entry, the slacks last in z,
-        after the layout's unknowns): the program stays feasible whatever the state."""
+        soft_bound_weight s^2 (at the optimum |s| is the violation; one two-sided row per
+        entry, the slacks last in z, after the layout's unknowns): the program stays
+        feasible whatever the state."""
         nv, nu = B.shape
         if not (np.all((B == 0) | (B == 1)) and np.all(B.sum(axis=0) == 1)):
             raise ValueError("the actuation matrix B must select one velocity per actuator")
@@ -242,12 +109,45 @@ class WholeBodyQp:
         self._velocity_gain = contact_velocity_gain_per_s
         self._torque_limit_Nm = torque_limit_Nm
         self._torque_weight = torque_weight
-        nw, nc = layout.n_wrench, len(contacts)
+        nw = layout.n_wrench
         self._soft_bounds = soft_bounds
         n_soft = 0 if soft_bounds is None else len(soft_bounds.v_indices)
         self.n = n = layout.n + n_soft  # unknowns: the layout's, then the slacks
         self._slack = slice(layout.n, n)
 
+        rows_acc, rows_dynamics = self._lay_out_rows(nu, n_soft)
+        self._set_up_screening(n_soft)
+        # The constrained contacts' rows are equalities (all rows held) until solve() gets
+        # QpContactBounds.partially_held: the last one it got.
+        self._equality[self._bounds(rows_acc)] = 1
+        self._partially_held: dict[int, np.ndarray] = {}
+        # Rows of A that the last partially_held leaves free (None: all held).
+        self._free_rows: np.ndarray | None = None
+        self._acceleration_bounds = acceleration_bounds
+        self._make_views(B, rows_acc, rows_dynamics)
+        self._H_regularisation = np.diag(
+            np.concatenate(
+                [
+                    np.full(nw, wrench_weight),
+                    np.full(nv, acceleration_weight),
+                    np.full(n_soft, soft_bound_weight),
+                ]
+            )
+        )
+        self.tasks = list(tasks)
+        # mode -> its ActiveTasks.
+        self._active_tasks = self._tasks_by_mode(modes)
+        # Without the torque rows (tried first), and with them (module docstring): A, lo,
+        # hi, equality and a backend for each.
+        A, lo, hi, m = self._A, self._lo, self._hi, self._rows_tau.stop
+        self._programs = [
+            (A[:rows], lo[: n + rows], hi[: n + rows], self._equality[: n + rows], None)
+            for rows in (self._rows_tau.start, m)
+        ]
+
+    def _lay_out_rows(self, nu: int, n_soft: int) -> tuple[slice, slice]:
+        """Allocates A, lo, hi, equality with the constant rows; returns the held and (1) rows."""
+        layout, contacts, soft_bounds, n = self.layout, self.contacts, self._soft_bounds, self.n
         # Rows of A: accelerations of the constrained contacts (6 each), cones (10 per
         # contact), then the rows of (1): the six base rows and, last, the torques (nu),
         # tau = B^T (...) picking the actuated rows of a generalized force. The bound
@@ -280,24 +180,26 @@ class WholeBodyQp:
             A[rows_soft.start + entries, self._slack.start + entries] = -1.0
             self._soft_lo = lo[self._bounds(rows_soft)]
             self._soft_hi = hi[self._bounds(rows_soft)]
-        # Screening the soft rows (module docstring): their vdot columns, their rows of A,
-        # their slacks' entries of z; which joints the next tick keeps. daqp only: the
-        # Drake backends hold programs of one size.
-        self._soft_vdot = layout.vdot.start + (
+        self._rows_soft = rows_soft
+        return rows_acc, rows_dynamics
+
+    def _set_up_screening(self, n_soft: int) -> None:
+        """Screening the soft rows (module docstring): their vdot columns, the joints kept."""
+        # Their vdot columns, their rows of A, their slacks' entries of z; which joints the
+        # next tick keeps. daqp only: the Drake backends hold programs of one size.
+        soft_bounds = self._soft_bounds
+        self._soft_vdot = self.layout.vdot.start + (
             np.zeros(0, dtype=int) if soft_bounds is None else np.asarray(soft_bounds.v_indices)
         )
-        self._rows_soft = rows_soft
-        self._screen = bool(n_soft) and solver == "daqp"
+        self._screen = bool(n_soft) and self._solver == "daqp"
         self._soft_kept = np.zeros(n_soft, dtype=bool)
         self._screen_cache: dict[tuple[bytes, int], tuple[np.ndarray, ...]] = {}
         self.screening_resolves = 0  # ticks that had to solve again (a joint broke in)
-        # The constrained contacts' rows are equalities (all rows held) until solve() gets
-        # QpContactBounds.partially_held: the last one it got.
-        self._equality[self._bounds(rows_acc)] = 1
-        self._partially_held: dict[int, np.ndarray] = {}
-        # Rows of A that the last partially_held leaves free (None: all held).
-        self._free_rows: np.ndarray | None = None
-        # Views of A, lo, hi refilled each tick.
+
+    def _make_views(self, B: np.ndarray, rows_acc: slice, rows_dynamics: slice) -> None:
+        """The views of A, lo, hi that solve() refills each tick, and the indices it fills."""
+        A, lo, hi, layout = self._A, self._lo, self._hi, self.layout
+        nw, nc, nu = layout.n_wrench, len(self.contacts), B.shape[1]
         self._A_acc = A[rows_acc, layout.vdot]
         self._lo_acc, self._hi_acc = lo[self._bounds(rows_acc)], hi[self._bounds(rows_acc)]
         self._A_dynamics_F = A[rows_dynamics, :nw]
@@ -309,42 +211,28 @@ class WholeBodyQp:
         self._generalized_rows = as_slice(np.r_[np.arange(N_BASE), B.argmax(axis=0)])
         self._actuated = as_slice(B.argmax(axis=0))
         # lo, hi of the rows of (1) are r + these, r = tau_hand - h (rows in order).
-        self._dynamics_lo = np.r_[np.zeros(N_BASE), np.full(nu, -torque_limit_Nm)]
+        self._dynamics_lo = np.r_[np.zeros(N_BASE), np.full(nu, -self._torque_limit_Nm)]
         self._dynamics_hi = -self._dynamics_lo
         # The normal forces' entries of z.
         self._normal = np.array([layout.wrench(c).stop - 1 for c in range(nc)])
-        self._acceleration_bounds = acceleration_bounds
-        if acceleration_bounds is not None:
-            self._bounded_vdot = nw + np.asarray(acceleration_bounds.v_indices, dtype=int)
+        if self._acceleration_bounds is not None:
+            self._bounded_vdot = nw + np.asarray(self._acceleration_bounds.v_indices, dtype=int)
 
-        self._H_regularisation = np.diag(
-            np.concatenate(
-                [
-                    np.full(nw, wrench_weight),
-                    np.full(nv, acceleration_weight),
-                    np.full(n_soft, soft_bound_weight),
-                ]
-            )
-        )
-        self.tasks = list(tasks)
-        # mode -> its _ActiveTasks (modes with the same active tasks share one).
-        by_flags: dict[tuple[bool, ...], _ActiveTasks] = {}
-        self._active_tasks: dict[int, _ActiveTasks] = {}
+    def _tasks_by_mode(self, modes: tuple[int, ...]) -> dict[int, ActiveTasks]:
+        """Each mode's ActiveTasks (modes with the same active tasks share one)."""
+        by_flags: dict[tuple[bool, ...], ActiveTasks] = {}
+        active_tasks: dict[int, ActiveTasks] = {}
         for state in modes:
             flags = tuple(
                 task.active_states is None or state in task.active_states for task in self.tasks
             )
             if flags not in by_flags:
-                by_flags[flags] = self._precompute(
-                    [task for task, on in zip(self.tasks, flags, strict=True) if on]
+                by_flags[flags] = ActiveTasks.of(
+                    [task for task, on in zip(self.tasks, flags, strict=True) if on],
+                    self._H_regularisation,
                 )
-            self._active_tasks[state] = by_flags[flags]
-        # Without the torque rows (tried first), and with them (module docstring): A, lo,
-        # hi, equality and a backend for each.
-        self._programs = [
-            (A[:rows], lo[: n + rows], hi[: n + rows], self._equality[: n + rows], None)
-            for rows in (self._rows_tau.start, m)
-        ]
+            active_tasks[state] = by_flags[flags]
+        return active_tasks
 
     def _solve_screened(self, backend, H, g, A, lo, hi, equality) -> tuple[np.ndarray, bool]:
         """The program (A: its rows) solved without the soft rows of the joints whose limit
@@ -426,29 +314,6 @@ class WholeBodyQp:
         n = self.n
         return slice(n + rows.start, n + rows.stop)
 
-    def _precompute(self, tasks: list[Task]) -> _ActiveTasks:
-        """For a set of active tasks: H_fixed = regularisation + w A^T A of those with a
-        constant A, g_fixed = -w A^T b of the constant ones, in the tasks' order."""
-        H = self._H_regularisation.copy()
-        g = np.zeros(self.n)
-        tracking = []
-        for task in tasks:
-            if not task.constant_A:
-                continue
-            WA = task.A.T * task.weight
-            H[task.columns, task.columns] += WA @ task.A
-            if task.constant_b:
-                g[task.columns] -= WA @ task.b
-            else:
-                tracking.append((task, -WA))
-        return _ActiveTasks(
-            updated=[task for task in tasks if not (task.constant_A and task.constant_b)],
-            varying=[task for task in tasks if not task.constant_A],
-            tracking=tracking,
-            H_fixed=H,
-            g_fixed=g if g.any() else None,
-        )
-
     def solve(
         self,
         terms: RobotTerms,
@@ -466,82 +331,13 @@ class WholeBodyQp:
         active = self._active_tasks[references.standup_state]
         for task in active.updated:
             task.update(terms, references)
-        tau_hand = references.tau_hand
-        lo, hi = self._lo, self._hi
-        GT = self.contact_map(terms)
-
-        # (1) and (2), rows [-G, M] z in [r + lo, r + hi], r = tau_hand - h.
-        rows = self._generalized_rows
-        np.negative(GT.T[rows], out=self._A_dynamics_F)
-        self._A_dynamics_vdot[:] = terms.M[rows]
-        r = np.negative(terms.h) if tau_hand is None else tau_hand - terms.h
-        np.add(r[rows], self._dynamics_lo, out=self._lo_dynamics)
-        np.add(r[rows], self._dynamics_hi, out=self._hi_dynamics)
-
-        # Held contacts: the held rows of J_CP vdot = -Jdot_CP v - k J_CP v, in C.
-        self._A_acc[:] = terms.J_P.reshape(self._A_acc.shape)
-        np.negative(terms.Jdotv_P.reshape(-1), out=self._lo_acc)
-        if self._velocity_gain:
-            self._lo_acc -= self._velocity_gain * (self._A_acc @ terms.v)
-        self._hi_acc[:] = self._lo_acc
-        if commands.partially_held is not self._partially_held:
-            self._partially_held = commands.partially_held
-            free = [
-                WRENCH_SIZE * self._held.index(c) + np.flatnonzero(~held)
-                for c, held in commands.partially_held.items()
-            ]
-            self._free_rows = np.concatenate(free) if free else None
-            self._equality[self._bounds(slice(0, len(self._lo_acc)))] = 1
-            if self._free_rows is not None:
-                self._equality[self.n + self._free_rows] = 0
-        if self._free_rows is not None:
-            self._lo_acc[self._free_rows] = -np.inf
-            self._hi_acc[self._free_rows] = np.inf
-        # Normal forces (f_z comes last in F_c) and accelerations.
-        lo[self._normal] = commands.min_normal_force_N
-        hi[self._normal] = commands.max_normal_force_N
-        if self._acceleration_bounds is not None:
-            vdot_min, vdot_max = self._acceleration_bounds.calc(terms)
-            lo[self._bounded_vdot] = vdot_min
-            hi[self._bounded_vdot] = vdot_max
-        if self._soft_bounds is not None:
-            self._soft_lo[:], self._soft_hi[:] = self._soft_bounds.calc(terms)
-
-        # Cost: w_tau ||T z + t0||^2 with t0 = -r[actuated], the tasks, the fixed part.
-        T = self._T
+        r = self._fill_dynamics(terms, references.tau_hand)
+        self._fill_held_contacts(terms, commands.partially_held)
+        self._fill_bounds(terms, commands)
         r_actuated = r[self._actuated]
-        WT = self._torque_weight * T.T
-        H = WT @ T
-        H += active.H_fixed
-        g = WT @ r_actuated
-        np.negative(g, out=g)
-        if active.g_fixed is not None:
-            g += active.g_fixed
-        for task in active.varying:
-            WA = task.A.T * task.weight
-            H[task.columns, task.columns] += WA @ task.A
-            g[task.columns] -= WA @ task.b
-        for task, minus_WA in active.tracking:
-            g[task.columns] += minus_WA @ task.b
+        H, g = self._cost(active, r_actuated)
         t_assembled = time.perf_counter()
-
-        # Without the torque rows first (module docstring).
-        for k, (A, lo_k, hi_k, equality, backend) in enumerate(self._programs):
-            if backend is None:
-                backend = make_backend(self._solver, *A.shape[::-1])
-                self._programs[k] = A, lo_k, hi_k, equality, backend
-            z, ok = self._solve_screened(backend, H, g, A, lo_k, hi_k, equality)
-            tau = T @ z
-            tau -= r_actuated
-            if not ok or np.abs(tau).max() <= self._torque_limit_Nm:
-                break
-        ok = ok and bool(np.isfinite(z).all())
-        relaxed = False
-        if not ok:
-            z, ok = self._solve_relaxed(H, g)
-            tau = T @ z
-            tau -= r_actuated
-            relaxed = ok
+        z, ok, tau, relaxed = self._solve_within_limits(H, g, r_actuated)
         t_solved = time.perf_counter()
         nc, nw = len(self.contacts), self.layout.n_wrench
         F_C = np.zeros((nc, WRENCH_SIZE))
@@ -558,3 +354,88 @@ class WholeBodyQp:
             solve_s=t_solved - t_assembled,
             frame_rotations=terms.frame_rotations,
         )
+
+    def _fill_dynamics(self, terms: RobotTerms, tau_hand: np.ndarray | None) -> np.ndarray:
+        """Fills the rows of (1) and (2), [-G, M] z in [r + lo, r + hi]; r = tau_hand - h."""
+        GT = self.contact_map(terms)
+        rows = self._generalized_rows
+        np.negative(GT.T[rows], out=self._A_dynamics_F)
+        self._A_dynamics_vdot[:] = terms.M[rows]
+        r = np.negative(terms.h) if tau_hand is None else tau_hand - terms.h
+        np.add(r[rows], self._dynamics_lo, out=self._lo_dynamics)
+        np.add(r[rows], self._dynamics_hi, out=self._hi_dynamics)
+        return r
+
+    def _fill_held_contacts(self, terms: RobotTerms, partially_held: dict[int, np.ndarray]) -> None:
+        """Fills the held rows of J_CP vdot = -Jdot_CP v - k J_CP v, in C; frees the others."""
+        self._A_acc[:] = terms.J_P.reshape(self._A_acc.shape)
+        np.negative(terms.Jdotv_P.reshape(-1), out=self._lo_acc)
+        if self._velocity_gain:
+            self._lo_acc -= self._velocity_gain * (self._A_acc @ terms.v)
+        self._hi_acc[:] = self._lo_acc
+        if partially_held is not self._partially_held:
+            self._partially_held = partially_held
+            free = [
+                WRENCH_SIZE * self._held.index(c) + np.flatnonzero(~held)
+                for c, held in partially_held.items()
+            ]
+            self._free_rows = np.concatenate(free) if free else None
+            self._equality[self._bounds(slice(0, len(self._lo_acc)))] = 1
+            if self._free_rows is not None:
+                self._equality[self.n + self._free_rows] = 0
+        if self._free_rows is not None:
+            self._lo_acc[self._free_rows] = -np.inf
+            self._hi_acc[self._free_rows] = np.inf
+
+    def _fill_bounds(self, terms: RobotTerms, commands: QpContactBounds) -> None:
+        """Fills the bounds of the normal forces (f_z comes last in F_c) and accelerations."""
+        lo, hi = self._lo, self._hi
+        lo[self._normal] = commands.min_normal_force_N
+        hi[self._normal] = commands.max_normal_force_N
+        if self._acceleration_bounds is not None:
+            vdot_min, vdot_max = self._acceleration_bounds.calc(terms)
+            lo[self._bounded_vdot] = vdot_min
+            hi[self._bounded_vdot] = vdot_max
+        if self._soft_bounds is not None:
+            self._soft_lo[:], self._soft_hi[:] = self._soft_bounds.calc(terms)
+
+    def _cost(self, active: ActiveTasks, r_actuated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """H, g: w_tau ||T z + t0||^2 with t0 = -r[actuated], the tasks, the fixed part."""
+        T = self._T
+        WT = self._torque_weight * T.T
+        H = WT @ T
+        H += active.H_fixed
+        g = WT @ r_actuated
+        np.negative(g, out=g)
+        if active.g_fixed is not None:
+            g += active.g_fixed
+        for task in active.varying:
+            WA = task.A.T * task.weight
+            H[task.columns, task.columns] += WA @ task.A
+            g[task.columns] -= WA @ task.b
+        for task, minus_WA in active.tracking:
+            g[task.columns] += minus_WA @ task.b
+        return H, g
+
+    def _solve_within_limits(
+        self, H: np.ndarray, g: np.ndarray, r_actuated: np.ndarray
+    ) -> tuple[np.ndarray, bool, np.ndarray, bool]:
+        """z, ok, tau, relaxed: without the torque rows, then with them, then relaxed if need be."""
+        T = self._T
+        for k, (A, lo_k, hi_k, equality, backend) in enumerate(self._programs):
+            if backend is None:
+                backend = make_backend(self._solver, *A.shape[::-1])
+                self._programs[k] = A, lo_k, hi_k, equality, backend
+            z, ok = self._solve_screened(backend, H, g, A, lo_k, hi_k, equality)
+            tau = T @ z
+            tau -= r_actuated
+            if not ok or np.abs(tau).max() <= self._torque_limit_Nm:
+                break
+        ok = ok and bool(np.isfinite(z).all())
+        relaxed = False
+        if not ok:
+            z, ok = self._solve_relaxed(H, g)
+            tau = T @ z
+            tau -= r_actuated
+            relaxed = ok
+        return z, ok, tau, relaxed

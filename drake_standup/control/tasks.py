@@ -1,4 +1,4 @@
-"""The controller's least-squares tasks (control/qp.py: Task) and their feedback laws.
+"""The controller's least-squares tasks (control/qp_types.py: Task) and their feedback laws.
 
 Each task is w ||A z[columns] - b||^2 over the QP's unknowns z = [F_1 .. F_nc, vdot],
 refreshed by update(terms, references) from one tick's TaskReferences
@@ -30,7 +30,7 @@ class MomentumTask(Task):
     X_Com,c = [R, (p_C - p_Com) x R; 0, R] (R = R_WC) mapping [tau_C; f_C] to the wrench
     about the CoM in W (its force columns only for a point contact).
 
-    The first six columns of G^T (control/qp.py: ContactMap) map the contact unknowns to
+    The first six columns of G^T (control/qp_types.py: ContactMap) map the contact unknowns to
     their resultant wrench about the base origin Bo in W, and the first six entries of
     J_h^T F_hand are the hands' resultant there (control/terms.py); about the CoM,
     W_Com = [W_ang - p_BoCom x W_lin; W_lin]."""
