@@ -25,13 +25,10 @@ from drake_standup.control.contacts import CONTACTS
 from drake_standup.control.controller import DIAGNOSTICS, WholeBodyController
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
+from drake_standup.control.tasks import helpful_force
 from drake_standup.control.terms import RobotKinematics
 from drake_standup.standup.contact_schedule import contact_commands, phase_seat_hold
-from drake_standup.standup.task_references import (
-    PhaseReferences,
-    ReferenceGenerator,
-    helpful_force,
-)
+from drake_standup.standup.task_references import PhaseReferences, ReferenceGenerator
 from drake_standup.standup.transitions import initial_mode
 from drake_standup.standup.whole_body import StandupWholeBodyController
 from drake_standup.world.scene import add_scene, set_seated_state

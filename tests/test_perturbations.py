@@ -359,8 +359,7 @@ def test_noise_reaches_every_consumer_but_not_the_plant():
     expected[FORCES] += _spec_noise(5, 123, 3.0)
     systems = _systems(diagram)
     consumers = ["station/sensing"] + [
-        f"standup_controller/{name}"
-        for name in ("state_machine", "controller_model", "task_references")
+        f"standup_controller/{name}" for name in ("state_machine", "controller")
     ]
     for name in consumers:
         system = systems[name]
@@ -411,7 +410,7 @@ def test_mass_scale_acts_on_the_simulated_plant_only():
     np.testing.assert_allclose(plant.CalcMassMatrix(plant_context), s * M_nominal, rtol=1e-12)
 
     # The controller's terms, at the simulated state, use the nominal model.
-    model = _systems(built.diagram)["standup_controller/controller_model"]
+    model = _systems(built.diagram)["standup_controller/controller"].model
     terms = model.kinematics.calc(x, ["l_sole"])
     assert terms.mass_kg == pytest.approx(nominal, rel=1e-12)
     np.testing.assert_allclose(terms.M, M_nominal, rtol=1e-12, atol=1e-12)

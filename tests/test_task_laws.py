@@ -1,9 +1,10 @@
-"""Each task's law (drake_standup/control/tasks.py) on its own, at a random seated-plant
+"""Each task's law (drake_standup/control/tasks/) on its own, at a random seated-plant
 state, against values computed here without the package's code: Drake's frame poses,
 CoM, mass, Jacobians, SpatialForce shifts and axis-angles, hand-computed feedback laws,
 and the constant-acceleration motion integrated step by step."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -19,11 +20,14 @@ from drake_standup.control.qp import ContactMap
 from drake_standup.control.targets import TaskReferences
 from drake_standup.control.tasks import (
     BaseOrientationTask,
+    BaseTarget,
     CopCenteringTask,
     JointLimitBounds,
+    MomentumLaw,
     MomentumTask,
     PostureTask,
     StancePostureTask,
+    next_posture_reference,
 )
 from drake_standup.control.terms import RobotKinematics
 from drake_standup.world.scene import add_scene, set_seated_state
@@ -284,3 +288,108 @@ def test_joint_limit_bounds_land_on_the_limits_at_the_horizon(rig, seed):
     np.testing.assert_allclose(ends[0], q_min, atol=1e-9)
     np.testing.assert_allclose(ends[1], q_max, atol=1e-9)
     assert np.all((ends[2] >= q_min - 1e-9) & (ends[2] <= q_max + 1e-9))
+
+
+# --- The laws that make the tasks' targets, each on its own ----------------------------
+
+
+def _terms_at(p, v, L, mass_kg):
+    """The RobotTerms fields the momentum law reads."""
+    return SimpleNamespace(
+        p_WCom=np.array(p, float),
+        v_WCom=np.array(v, float),
+        L_WCom=np.array(L, float),
+        mass_kg=mass_kg,
+    )
+
+
+def test_the_momentum_law_is_the_papers_objective_component_by_component():
+    """Ldot* = [-K_D,ang L - K_P,ang int L; m (xd_ddot - K_D (v - xd_dot) - K_P (p - x_d))]
+    written out per component; no pull, no stance: no help, no height integral."""
+    config = ControllerConfig()
+    law = MomentumLaw(config, period_s=0.004, gravity_mps2=9.81)
+    terms = _terms_at([0.1, -0.02, 0.5], [0.2, 0.01, -0.1], [0.3, -0.4, 0.5, 0, 0, 0], 33.0)
+    target = [0.12, 0.0, 0.52, 0.25, 0.0, 0.05, 0.5, 0.1, -0.2]
+    kp, kd = np.array([60.0, 40.0, 30.0]), np.array([15.0, 12.0, 10.0])
+    integral = np.array([0.01, 0.02, -0.03])
+    out = law.target(terms, np.array(target), kp, kd, integral, 0.0, 0.0, None)
+    expected = []
+    for i in range(3):
+        expected.append(
+            -config.angular_momentum_kd_per_s * terms.L_WCom[i]
+            - config.angular_momentum_kp_per_s2 * integral[i]
+        )
+    for i in range(3):
+        xddot = target[6 + i] - kd[i] * (terms.v_WCom[i] - target[3 + i])
+        xddot -= kp[i] * (terms.p_WCom[i] - target[i])
+        expected.append(33.0 * xddot)
+    np.testing.assert_allclose(out.Ldot_star, expected, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(out.helpful_force_W, np.zeros(3))
+    assert out.next_height_integral == 0.0
+    np.testing.assert_allclose(out.next_momentum_integral, integral + 0.004 * terms.L_WCom[:3])
+
+
+def test_the_momentum_law_lets_through_only_the_pull_along_the_path():
+    """Past the fade speed and at the reference (no lead), f_par = (f . u) u for a pull
+    with a component along xd_dot, 0 for one against it; it adds to m xddot*, faded by the
+    stance."""
+    config = ControllerConfig()
+    law = MomentumLaw(config, period_s=0.004, gravity_mps2=9.81)
+    terms = _terms_at([0.1, 0.0, 0.5], [0.0, 0.0, 0.0], np.zeros(6), 33.0)
+    speed = 2.0 * config.help_fade_speed_mps
+    target = np.array([0.1, 0.0, 0.5, speed * 0.6, 0.0, speed * 0.8, 0.0, 0.0, 0.0])
+    kp = kd = np.zeros(3)
+    pull = np.array([20.0, 5.0, 10.0])
+    along = 20.0 * 0.6 + 10.0 * 0.8
+    for stance in (0.0, 0.5):
+        out = law.target(terms, target, kp, kd, np.zeros(3), stance, 0.0, pull)
+        f_par = (1.0 - stance) * along * np.array([0.6, 0.0, 0.8])
+        np.testing.assert_allclose(out.helpful_force_W, f_par, atol=1e-12)
+        np.testing.assert_allclose(out.Ldot_star[3:5], f_par[:2], atol=1e-12)
+    against = law.target(terms, target, kp, kd, np.zeros(3), 0.0, 0.0, -pull)
+    np.testing.assert_array_equal(against.helpful_force_W, np.zeros(3))
+
+
+def test_the_stance_height_integral_accumulates_and_is_bounded():
+    """I <- clip(I + T s (z_d - z), +-0.2 g / K_I), and m K_I I adds to the vertical
+    force; a large error saturates at the bound."""
+    config = ControllerConfig()
+    law = MomentumLaw(config, period_s=0.004, gravity_mps2=9.81)
+    terms = _terms_at([0.0, 0.0, 0.50], np.zeros(3), np.zeros(6), 33.0)
+    target = np.array([0.0, 0.0, 0.52, 0, 0, 0, 0, 0, 0])
+    zero = np.zeros(3)
+    out = law.target(terms, target, zero, zero, zero, 0.5, 0.001, None)
+    integral = 0.001 + 0.004 * 0.5 * 0.02
+    assert out.next_height_integral == pytest.approx(integral, rel=1e-12)
+    ki = config.stance_height_ki_per_s3
+    assert out.Ldot_star[5] == pytest.approx(33.0 * ki * integral, rel=1e-12)
+    limit = 0.2 * 9.81 / ki
+    saturated = law.target(terms, target, zero, zero, zero, 1.0, 10.0 * limit, None)
+    assert saturated.next_height_integral == pytest.approx(limit, rel=1e-12)
+
+
+def test_the_posture_reference_is_a_first_order_filter():
+    """After n ticks toward a fixed target from q0: q_n = q* + (q0 - q*) (1 - b)^n (closed
+    form); a held joint's target is the first posture, clamped inside the limits."""
+    q0 = np.array([0.5, -1.0, 2.0])
+    target = np.array([0.1, -0.2, np.nan])
+    hold = np.array([False, False, True])
+    low, high = np.full(3, -1.5), np.full(3, 1.5)
+    blend = 0.04
+    q = q0.copy()
+    for _ in range(25):
+        q = next_posture_reference(q0, q, hold, target, low, high, blend)
+    goal = np.array([0.1, -0.2, 1.5])  # the held joint: 2.0 clamped to 1.5
+    np.testing.assert_allclose(q, goal + (q0 - goal) * (1.0 - blend) ** 25, rtol=1e-12)
+
+
+def test_the_base_target_is_the_first_yaw_and_the_states_forward_pitch():
+    """R_WB* = Rz(yaw) Ry(-pitch) by Drake's RotationMatrix. root_link's x axis points
+    backwards: seated facing +x its yaw is pi, and a forward pitch must tip the base's z
+    axis toward +x, by sin(pitch)."""
+    target = BaseTarget()
+    for yaw, pitch in ((0.0, 0.4), (0.7, 0.3), (-1.2, 0.0)):
+        expected = RotationMatrix.MakeZRotation(yaw) @ RotationMatrix.MakeYRotation(-pitch)
+        np.testing.assert_allclose(target(yaw, pitch), expected.matrix(), atol=1e-15)
+    z_axis = target(math.pi, 0.4)[:, 2]
+    np.testing.assert_allclose(z_axis, [math.sin(0.4), 0.0, math.cos(0.4)], atol=1e-15)

@@ -18,13 +18,13 @@ from drake_standup.config.phases import PHASES, PhaseTable
 from drake_standup.control.model import HANDS, ControllerJoints
 from drake_standup.control.qp import as_slice
 from drake_standup.control.terms import RobotKinematics
+from drake_standup.robot.balance import static_lean
 from drake_standup.standup.task_references import (
     ADVANCEMENT,
     COMPLIANT,
     STIFF,
     PhaseReferences,
     ReferenceGenerator,
-    static_lean,
 )
 from drake_standup.world.scene import add_scene, set_seated_state
 from drake_standup.world.sensing import StandingSupport, standing_lean, standing_pull_usage
@@ -258,7 +258,7 @@ def test_the_compliant_offset_settles_only_where_the_standing_feet_hold_the_pull
     half_x = (SUPPORT.cop_x_m[1] - SUPPORT.cop_x_m[0]) / 2
     reach = (CONFIG.lean_max_back_m if pull_N > 0 else CONFIG.lean_max_forward_m) + half_x
     box = np.array(Scenario().compliance.max_offset_m)
-    low, high = generator._offset_bounds(rig["schedule"][3], hands, weight)
+    low, high = generator.com_target.offset_bounds(rig["schedule"][3], hands, weight)
     toward, away = (high[0], low[0]) if pull_N > 0 else (-low[0], -high[0])
     assert toward == pytest.approx(min(max(0.0, (limit - usage) * reach), box[0]), abs=1e-12)
     assert away == -box[0]
@@ -276,7 +276,7 @@ def test_on_the_feet_alone_the_compliant_offset_settles_no_higher_than_the_path(
     box = np.array(Scenario().compliance.max_offset_m)
     pull = np.tile([0.0, 0.0, 0.0, 0.0, 0.0, 10.0], 2)
     for state in (1, 2, 3, 4):
-        low, high = generator._offset_bounds(rig["schedule"][state], pull, 300.0)
+        low, high = generator.com_target.offset_bounds(rig["schedule"][state], pull, 300.0)
         assert high[2] == (0.0 if TABLE.phase(state).lean else box[2])
         assert low[2] == -box[2]
 

@@ -79,11 +79,47 @@ def make_program(
     torque_limit_Nm: float,
     modes: tuple[int, ...],
 ) -> Program:
-    """The QP over the active contacts with the controller's tasks (control/tasks.py):
+    """The QP over the active contacts with the controller's tasks (control/tasks/):
     momentum, CoP centering, posture; in the stance states the legs' posture and the
     arms' (growing with the stance); base orientation; soft joint-limit bounds."""
     contacts = [spec for spec, on in zip(specs, active, strict=True) if on]
     contact_map = ContactMap(contacts, plant.num_velocities())
+    qp = WholeBodyQp(
+        contact_map,
+        plant.MakeActuationMatrix(),
+        torque_limit_Nm=torque_limit_Nm,
+        torque_weight=config.torque_weight,
+        wrench_weight=config.wrench_weight,
+        acceleration_weight=config.acceleration_weight,
+        tasks=_tasks(contacts, contact_map, plant, joints, config, stance_states),
+        modes=modes,
+        soft_bounds=JointLimitBounds(
+            joints.q_indices,
+            joints.v_indices,
+            joints.q_min,
+            joints.q_max,
+            config.joint_limit_horizon_s,
+        ),
+        soft_bound_weight=config.joint_limit_weight,
+        solver=config.qp_solver,
+        contact_velocity_gain_per_s=config.contact_velocity_gain_per_s,
+    )
+    return Program(
+        qp=qp,
+        contact_index=np.array([CONTACTS.index(spec.frame) for spec in contacts]),
+        partially_held=_partially_held(contacts),
+    )
+
+
+def _tasks(
+    contacts: list[ContactSpec],
+    contact_map: ContactMap,
+    plant: MultibodyPlant,
+    joints: ControllerJoints,
+    config: ControllerConfig,
+    stance_states: set[int],
+) -> list:
+    """The program's tasks, in the order the QP adds their costs."""
     layout = contact_map.layout
 
     def weights(table: dict[str, float], key: str, default: float) -> np.ndarray:
@@ -101,7 +137,7 @@ def make_program(
             active_states=states,
         )
 
-    tasks = [
+    return [
         MomentumTask(
             layout, contact_map, plant.gravity_field().gravity_vector(), config.momentum_weight
         ),
@@ -132,28 +168,15 @@ def make_program(
             config.base_orientation_damping_ratio,
         ),
     ]
-    qp = WholeBodyQp(
-        contact_map,
-        plant.MakeActuationMatrix(),
-        torque_limit_Nm=torque_limit_Nm,
-        torque_weight=config.torque_weight,
-        wrench_weight=config.wrench_weight,
-        acceleration_weight=config.acceleration_weight,
-        tasks=tasks,
-        modes=modes,
-        soft_bounds=JointLimitBounds(
-            joints.q_indices,
-            joints.v_indices,
-            joints.q_min,
-            joints.q_max,
-            config.joint_limit_horizon_s,
-        ),
-        soft_bound_weight=config.joint_limit_weight,
-        solver=config.qp_solver,
-        contact_velocity_gain_per_s=config.contact_velocity_gain_per_s,
-    )
-    # The seat's held rows: all (held), all but its pitch about the hip axis (hinged:
-    # alpha_y in C), none (free).
+
+
+def _partially_held(
+    contacts: list[ContactSpec],
+) -> dict[tuple[str, str], dict[int, np.ndarray]]:
+    """(HOLDS, THIGH_HOLDS) -> the rows each seat and thigh contact holds. The seat's:
+    all (held), all but its pitch about the hip axis (hinged: alpha_y in C), none (free);
+    a thigh on the chair does not sink (a_z in C); seated flat, it does not pitch either
+    (alpha_y)."""
     seat = [c for c, spec in enumerate(contacts) if spec.frame == "seat"]
     thighs = [c for c, spec in enumerate(contacts) if spec.frame in ("l_thigh", "r_thigh")]
     hinged = np.ones(WRENCH_SIZE, dtype=bool)
@@ -163,8 +186,6 @@ def make_program(
         "hinged": hinged,
         "free": np.zeros(WRENCH_SIZE, dtype=bool),
     }
-    # A thigh on the chair does not sink (a_z in C); seated flat, it does not pitch
-    # either (alpha_y).
     thigh_rows = {hold: np.zeros(WRENCH_SIZE, dtype=bool) for hold in THIGH_HOLDS}
     thigh_rows["normal"][NORMAL] = True
     thigh_rows["flat"][[1, NORMAL]] = True
@@ -174,11 +195,7 @@ def make_program(
             held = {c: rows[hold] for c in seat}
             held.update({c: thigh_rows[thighs_hold] for c in thighs})
             partially_held[(hold, thighs_hold)] = held
-    return Program(
-        qp=qp,
-        contact_index=np.array([CONTACTS.index(spec.frame) for spec in contacts]),
-        partially_held=partially_held,
-    )
+    return partially_held
 
 
 @dataclass

@@ -48,8 +48,8 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, Context, ContinuousState, LeafSystem
 
 from drake_standup.config import AdvancementConfig
+from drake_standup.control.smooth import smoothstep
 from drake_standup.ports.caching import declare_cached
-from drake_standup.standup.com_path import smoothstep
 
 
 def helpfulness(tangent: np.ndarray, omega_f: np.ndarray, eps: float) -> float:

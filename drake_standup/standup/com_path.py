@@ -1,4 +1,8 @@
-"""CoMReferenceGenerator: the CoM path x_d(psi) and its time derivatives.
+"""The CoM target as one chain: the segment, its min jerk, the lean, the compliance.
+
+CoMReferenceGenerator (a system: psi is the advancement's continuous state) gives the CoM
+path x_d(psi) and its time derivatives; CoMTarget (a plain object of the controller's
+tick) leans it against the pull and, in the compliant response, yields it to the pull.
 
 Each stand-up state k >= 2 moves the CoM along a min-jerk segment
     x_d(psi) = x_start + delta * s(tau),  tau = clamp((psi - psi_entry) / T, 0, 1),
@@ -12,19 +16,19 @@ as x_start) and s', s'' vanish at both ends, so value and slope are continuous.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+
 import numpy as np
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
+from drake_standup.config import ComplianceConfig, ControllerConfig
+from drake_standup.control.targets import StateReferences
+from drake_standup.control.terms import RobotTerms
 from drake_standup.ports.caching import declare_cached
+from drake_standup.robot.balance import static_lean
 
 SEGMENT_SIZE = 8  # [psi_entry, T, x_start (3), delta (3)]
-
-
-def smoothstep(r: float) -> float:
-    """3 r^2 - 2 r^3 on r clamped to [0, 1]: 0 -> 1 with zero slope at both ends (the
-    fades and ramps of the advancement, the controller and the seat's unloading)."""
-    r = min(max(r, 0.0), 1.0)
-    return r * r * (3.0 - 2.0 * r)
 
 
 def min_jerk(tau: float) -> tuple[float, float, float]:
@@ -111,3 +115,152 @@ class CoMReferenceGenerator(LeafSystem):
 
     def _CalcProgress(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, self._path.Eval(context)[3])
+
+
+class CoMTarget:
+    """The CoM reference the momentum task tracks this tick: x_d(psi), leaned against the
+    measured pull where the feet alone carry the robot, and moved by the compliant
+    response's admittance (standup/task_references.py's docstring)."""
+
+    def __init__(
+        self,
+        config: ControllerConfig,
+        period_s: float,
+        gravity_mps2: float,
+        compliance: ComplianceConfig | None = None,
+        standing_need: Callable | None = None,
+        usage_limit: float = 1.0,
+    ):
+        """compliance: the admittance of the compliant response (default: its defaults);
+        standing_need(F_hand_W, weight_N): what the pull asks of the standing feet, (d,
+        reach) or None (sensing.standing_lean), and usage_limit the share of their reach
+        the compliant offset may use (None: the box alone)."""
+        self._config = config
+        self._period_s = period_s
+        self._gravity_mps2 = gravity_mps2
+        self._standing_need = standing_need
+        self._usage_limit = usage_limit
+        compliance = compliance or ComplianceConfig()
+        mass, stiffness = compliance.virtual_mass_kg, compliance.stiffness_N_per_m
+        self._admittance = (
+            mass,
+            2.0 * compliance.damping_ratio * math.sqrt(stiffness * mass),
+            stiffness,
+            np.array(compliance.max_offset_m),
+        )
+        self._lean_blend = min(period_s / config.lean_filter_time_constant_s, 1.0)
+
+    def target(
+        self,
+        terms: RobotTerms,
+        state: StateReferences,
+        com_reference: np.ndarray,
+        tau_hand: np.ndarray | None,
+        F_hand_W: np.ndarray | None,
+        lean_W: np.ndarray | None,
+        compliance: np.ndarray,
+        compliant: bool,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(the CoM target [x, xdot, xddot] (9,), the lean after this tick (3), the
+        admittance's [offset, rate] after it (6)). com_reference: x_d(psi) and its
+        derivatives; tau_hand = J_h^T F_hand (None: no pull); lean_W, compliance: their
+        values before the tick; compliant: the response yields to the pull."""
+        lean = self._lean(terms, state, tau_hand, lean_W)
+        if lean.any():
+            # Leaning is tilting about the feet: the CoM target keeps its distance from
+            # the floor point below the unleaned target, so it drops as it leans (2 cm at
+            # a 15 cm lean); an unchanged height asked for legs longer than straight.
+            com_reference = com_reference.copy()
+            height = com_reference[2]
+            com_reference[:2] += lean[:2]
+            com_reference[2] = math.sqrt(max(height * height - lean[0] ** 2 - lean[1] ** 2, 0.0))
+        pulled = F_hand_W is not None and compliant
+        next_compliance = compliance
+        if pulled or compliance.any():
+            anchor = np.zeros(3)
+            if pulled:
+                bounds = self.offset_bounds(state, F_hand_W, terms.mass_kg * self._gravity_mps2)
+                anchor = np.clip((F_hand_W[3:6] + F_hand_W[9:12]) / self._admittance[2], *bounds)
+            next_compliance = self._yield(anchor, compliance)
+            com_reference = com_reference + np.concatenate(
+                (
+                    next_compliance,
+                    (next_compliance[3:] - compliance[3:]) / self._period_s,
+                )
+            )
+        return com_reference, lean, next_compliance
+
+    def _lean(
+        self,
+        terms: RobotTerms,
+        state: StateReferences,
+        tau_hand: np.ndarray | None,
+        lean_W: np.ndarray | None,
+    ) -> np.ndarray:
+        """tau_hand: the hands' generalized force J_h^T F_hand (None: no pull), whose first
+        six entries are their resultant about the base origin (control/terms.py).
+
+        The lean's next value: static_lean of the measured pull, bounded forward and
+        back by the feet (lean_max_forward_m, lean_max_back_m; lean_max_m sideways),
+        first-order filtered (lean_filter_time_constant_s), in the states that stand on
+        the feet alone; it decays back to zero in the others and when the pull stops."""
+        lean = np.zeros(3) if lean_W is None else lean_W
+        target = np.zeros(3)
+        if state.lean and tau_hand is not None:
+            wrench = tau_hand[:6].copy()
+            wrench[:3] -= np.cross(terms.p_BoCom, wrench[3:])
+            target = static_lean(
+                wrench,
+                float(terms.p_WCom[2]),
+                terms.mass_kg * self._gravity_mps2,
+                self._config.lean_max_m,
+            )
+            target[0] = min(
+                max(target[0], -self._config.lean_max_back_m), self._config.lean_max_forward_m
+            )
+        if not (target.any() or lean.any()):
+            return lean
+        return lean + self._lean_blend * (target - lean)
+
+    def offset_bounds(
+        self, state: StateReferences, F_hand_W: np.ndarray, weight_N: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(low, high) of where the compliant offset may settle this tick (the anchor of
+        _yield): within compliance.max_offset_m; horizontally, only as far as the
+        standing feet could hold the pull with the CoM moved by x: the lean the pull then
+        needs, d - x (standing_need: d and the feet's reach, judged on the robot standing
+        whatever its posture now, as the stand-up's wait is), within standup.
+        standing_pull_usage_limit of their reach, or x settles at 0 on that side; and, on
+        the feet alone (the states that lean), not above the path: the legs carry the rise
+        on the path's own timing (an upward yield ran the CoM 1.2 cm past the erect height
+        at the rise's end, at a 1 ms step; measured)."""
+        box = self._admittance[3]
+        low, high = -box.copy(), box.copy()
+        need = None if self._standing_need is None else self._standing_need(F_hand_W, weight_N)
+        if need is not None:
+            d, (forward, back, side) = need
+            limit = self._usage_limit
+            high[:2] = np.minimum(high[:2], np.maximum(0.0, d[:2] + limit * np.array([back, side])))
+            low[:2] = np.maximum(
+                low[:2], np.minimum(0.0, d[:2] - limit * np.array([forward, side]))
+            )
+        if state.lean:
+            high[2] = 0.0
+        return low, high
+
+    def _yield(self, anchor: np.ndarray, compliance: np.ndarray) -> np.ndarray:
+        """The admittance's next [offset, rate] (6,) from this tick's [offset, rate], by
+        semi-implicit Euler, pulled toward anchor (3: where the pull alone would hold the
+        offset, f / K within offset_bounds; 0 with no pull): so the offset follows a
+        bound that moves as smoothly as it follows a pull, critically damped, instead of
+        jumping to it. compliance.max_offset_m holds it in any case, with no rate outward
+        there."""
+        mass, damping, stiffness, box = self._admittance
+        x, v = compliance[:3], compliance[3:]
+        force = -damping * v - stiffness * (x - anchor)
+        v_next = v + (self._period_s / mass) * force
+        x_next = x + self._period_s * v_next
+        held = np.clip(x_next, -box, box)
+        outward = (held != x_next) & (v_next * x_next > 0.0)
+        v_next[outward] = 0.0
+        return np.concatenate((held, v_next))

@@ -34,7 +34,8 @@ import numpy as np
 
 from drake_standup.config import StandupConfig
 from drake_standup.config.phases import PHASES, SEAT_PADS, Guard, Phase, PhaseTable
-from drake_standup.standup.com_path import path, smoothstep
+from drake_standup.control.smooth import smoothstep
+from drake_standup.standup.com_path import path
 
 N_STATES = len(PHASES)
 _NAN3 = (math.nan, math.nan, math.nan)

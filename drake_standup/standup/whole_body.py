@@ -59,7 +59,7 @@ class StandupWholeBodyController(LeafSystem):
         period_s: float,
     ):
         super().__init__()
-        self._schedule, self._model = schedule, model
+        self._schedule, self.model = schedule, model
         self._generator, self.controller = generator, controller
         nu = controller.num_actuators
         self._inputs = {
@@ -116,7 +116,7 @@ class StandupWholeBodyController(LeafSystem):
         state = context.get_discrete_state()
         mode: StandupMode = self._mode.Eval(context)
         hands = self._input("hand_wrenches_W", context)
-        weighing = self._model.next_weighing(
+        weighing = self.model.next_weighing(
             state.get_value(self._weighing),
             mode.state,
             hands,
@@ -129,7 +129,7 @@ class StandupWholeBodyController(LeafSystem):
             state.get_value(self._diagnostics)[_COMMANDED],
             lambda: self._input("seat_pad_normal_forces_N", context),
         )
-        terms = self._model.terms(
+        terms = self.model.terms(
             self._input("robot_state", context), commands, hands, float(weighing[2])
         )
         t_terms = time.perf_counter()
