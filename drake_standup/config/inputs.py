@@ -217,11 +217,10 @@ def robot_names() -> list[str]:
     return sorted(icub_models.get_robot_names())
 
 
-@functools.cache
-def model_names(model: str) -> ModelNames:
-    """The names of model's URDF as icub-models installs it (robot.original_urdf), read as
-    XML: no plant is built. Cached per model: a sweep validates every run."""
-    root = ET.parse(icub_models.get_model_file(model)).getroot()
+def frame_links(root: ET.Element) -> set[str]:
+    """The links of a URDF (its root element) that become frames instead of bodies (the
+    one rule: robot/urdf.py removes them, model_names counts them out): a link with
+    neither mass nor visual on a fixed joint, all its children alike."""
     links = {link.get("name"): link for link in root.findall("link")}
     joints = root.findall("joint")
     parent_joint = {joint.find("child").get("link"): joint for joint in joints}
@@ -229,8 +228,6 @@ def model_names(model: str) -> ModelNames:
     for joint in joints:
         children[joint.find("parent").get("link")].append(joint.find("child").get("link"))
 
-    # urdf._remove_bare_subtrees' rule (tests/test_inputs.py checks it on a built plant):
-    # a link without mass or visual on a fixed joint, all its children alike, is a frame.
     @functools.cache
     def becomes_frame(name: str) -> bool:
         joint, link = parent_joint.get(name), links[name]
@@ -243,10 +240,24 @@ def model_names(model: str) -> ModelNames:
             and all(becomes_frame(child) for child in children[name])
         )
 
+    return {name for name in links if becomes_frame(name)}
+
+
+@functools.cache
+def model_names(model: str) -> ModelNames:
+    """The names of model's URDF as icub-models installs it (robot.original_urdf), read as
+    XML: no plant is built. Cached per model: a sweep validates every run."""
+    root = ET.parse(icub_models.get_model_file(model)).getroot()
+    links = [link.get("name") for link in root.findall("link")]
+    frames = frame_links(root)
     return ModelNames(
         links=tuple(links),
-        joints=tuple(j.get("name") for j in joints if j.get("type") in ("revolute", "continuous")),
-        reduced_bodies=tuple(name for name in links if not becomes_frame(name)),
+        joints=tuple(
+            j.get("name")
+            for j in root.findall("joint")
+            if j.get("type") in ("revolute", "continuous")
+        ),
+        reduced_bodies=tuple(name for name in links if name not in frames),
     )
 
 

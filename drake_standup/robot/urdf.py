@@ -20,7 +20,7 @@ from pathlib import Path
 
 from pydrake.math import RigidTransform, RollPitchYaw
 
-from drake_standup.config.inputs import robot_names
+from drake_standup.config.inputs import frame_links, robot_names
 from drake_standup.robot.meshes import cache_dir, converted_obj
 
 DEFAULT_MODEL = "iCubGazeboV2_5"
@@ -47,17 +47,6 @@ def _pose(elem: ET.Element | None) -> RigidTransform:
     xyz = [float(s) for s in elem.get("xyz", "0 0 0").split()]
     rpy = [float(s) for s in elem.get("rpy", "0 0 0").split()]
     return RigidTransform(RollPitchYaw(rpy), xyz)
-
-
-def _is_bare(link: ET.Element) -> bool:
-    """True for a link that carries no mass and shows nothing."""
-    if link.find("visual") is not None:
-        return False
-    inertial = link.find("inertial")
-    if inertial is None:
-        return True
-    mass = inertial.find("mass")
-    return mass is None or float(mass.get("value", "0")) == 0.0
 
 
 @dataclass
@@ -157,14 +146,10 @@ def _remove_bare_subtrees(robot: ET.Element, links: dict[str, ET.Element]) -> li
     def child_of(joint: ET.Element) -> str:
         return joint.find("child").get("link")
 
+    frames_only = frame_links(robot)
+
     def removable(name: str) -> bool:
-        joint = parent_joint.get(name)
-        return (
-            joint is not None
-            and joint.get("type") == "fixed"
-            and _is_bare(links[name])
-            and all(removable(child_of(j)) for j in children[name])
-        )
+        return name in frames_only
 
     frames: list[LeafFrame] = []
 
