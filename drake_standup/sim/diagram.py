@@ -94,7 +94,7 @@ def build_diagram(
     station = make_station(
         scenario, (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad) if seat_hold else None
     )
-    plan = make_plan(scenario, station.scene)
+    plan = make_plan(scenario, station)
     builder = DiagramBuilder()
     world, human, outputs = _add_station_and_human(builder, station, scenario, make_human)
     standup = None

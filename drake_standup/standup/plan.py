@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 from drake_standup.config import Scenario
 from drake_standup.config.phases import PHASES, SEAT_PADS, PhaseTable, resolve_com_heights
-from drake_standup.world.scene import Scene, erect_com_height_m
+from drake_standup.world.scene import erect_com_height_m
+from drake_standup.world.station import Station
 
 
 @dataclass(frozen=True)
@@ -32,19 +33,36 @@ class StandupPlan:
         return len(PHASES)
 
     @property
+    def states(self) -> tuple[int, ...]:
+        return tuple(range(1, self.n_states + 1))
+
+    @property
     def final_state(self) -> int:
         return self.n_states
 
+    @property
+    def stance_states(self) -> set[int]:
+        """The states whose phase ends on the legs' posture (the stance tasks act)."""
+        return {k for k, phase in enumerate(self.table, start=1) if phase.stance}
 
-def make_plan(scenario: Scenario, scene: Scene) -> StandupPlan:
-    """The plan for scenario's robot in scene: each standing posture's CoM height from
-    forward kinematics (scene.erect_com_height_m), once per distinct posture."""
+
+def _posture_key(posture_rad: dict[str, float]) -> tuple:
+    return tuple(sorted(posture_rad.items()))
+
+
+def make_plan(scenario: Scenario, station: Station) -> StandupPlan:
+    """The plan for scenario's robot in the station's scene: each standing posture's CoM
+    height from forward kinematics (scene.erect_com_height_m), once per distinct posture;
+    the rise's is the station's own where it stands erect (its standing support)."""
+    rise = scenario.phases.rise
     heights: dict[tuple, float] = {}
+    if rise.com_height_m is None:
+        heights[_posture_key(rise.posture_rad)] = station.standing.com_height_m
 
     def erect(posture_rad: dict[str, float]) -> float:
-        key = tuple(sorted(posture_rad.items()))
+        key = _posture_key(posture_rad)
         if key not in heights:
-            heights[key] = erect_com_height_m(scene, scenario, posture_rad)
+            heights[key] = erect_com_height_m(station.scene, scenario, posture_rad)
         return heights[key]
 
     table = resolve_com_heights(scenario.phases, erect)
