@@ -31,6 +31,10 @@ from dataclasses import dataclass, field
 PHASES = ("seated", "forward", "lift_off", "rise")
 # Pad groups of the chair whose load a phase can release (models/icub_contact.yaml).
 SEAT_PADS = ("buttocks", "thighs")
+# The seat's pads in the one order every consumer keeps (the station's
+# seat_pad_normal_forces_N, the seat loads, the controller's chair contacts): each pad's
+# frame (robot.TASK_FRAMES' key) and the group a phase releases it with.
+SEAT_PAD_ROWS = (("buttocks", "buttocks"), ("l_thigh", "thighs"), ("r_thigh", "thighs"))
 SEAT_HOLDS = ("held", "hinged")
 # What a phase does under a pull against the stand-up (standup/transitions.py).
 WHEN_HINDERED = ("wait", "sit_back", "step_back", "stand")

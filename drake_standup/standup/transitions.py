@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drake_standup.config import StandupConfig
-from drake_standup.config.phases import PHASES, SEAT_PADS, Guard, Phase, PhaseTable
+from drake_standup.config.phases import PHASES, SEAT_PAD_ROWS, SEAT_PADS, Guard, Phase, PhaseTable
 from drake_standup.control.smooth import smoothstep
 from drake_standup.standup.com_path import path
 
@@ -377,7 +377,7 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
 
 
 # The seat pads, as seat_loads orders them, and their pad group (phases.SEAT_PADS).
-SEAT_LOADS = ("buttocks", "thighs", "thighs")
+SEAT_LOADS = tuple(group for _, group in SEAT_PAD_ROWS)
 
 
 def seat_releases(table: PhaseTable) -> list[tuple[int, float, list[int], int]]:

@@ -33,6 +33,7 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import MatrixGain, PassThrough
 
 from drake_standup.config import Scenario
+from drake_standup.config.phases import SEAT_PAD_ROWS
 from drake_standup.ports.payloads import HAND_WRENCHES
 from drake_standup.robot.icub import ActuatedJoints, Robot, actuated_joints
 from drake_standup.world.pad_forces import ContactForceReporter
@@ -49,7 +50,7 @@ from drake_standup.world.sensing import RobotSensing, StandingSupport, heel_poin
 # Pad groups as metrics.json reports them (plural where there are two).
 _GROUP_LABELS = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
 # The pads under the seat pads of the contact schedule (control/schedule.py), in order.
-SEAT_PAD_FRAMES = ("buttocks", "l_thigh", "r_thigh")
+SEAT_PAD_FRAMES = tuple(frame for frame, _ in SEAT_PAD_ROWS)
 
 
 @dataclass
