@@ -31,6 +31,7 @@ from drake_standup.config import (
     read_text_file,
 )
 from drake_standup.config.resources import find, shipped
+from drake_standup.sim.progress import ProgressBar
 
 
 class SweepError(ValueError):
@@ -72,6 +73,9 @@ class SweepSpec:
     random: list[Parameter]
     perturbations: dict
     figures: list[Figure]
+    # Its runs, checked once when the file is loaded (load_sweep), so that running it
+    # does not check them again.
+    runs: list[RunSpec] | None = None
 
 
 @dataclass
@@ -145,7 +149,7 @@ def load_sweep(path: str | Path) -> SweepSpec:
     names = [p.name for p in spec.grid + spec.random]
     if len(set(names)) != len(names):
         raise SweepError(f"grid/random: a column name is used twice in {names}")
-    expand(spec)  # every key path and value checked against the base scenario now
+    spec.runs = expand(spec)  # every key path and value checked against the base now
     return spec
 
 
@@ -284,8 +288,13 @@ def check_run_count(spec: SweepSpec) -> int:
 def expand(spec: SweepSpec) -> list[RunSpec]:
     """Grid x samples runs; run k's draws come from the generator seeded by
     (seed, k), so a run's parameters don't depend on the others. Checks every
-    key path and value against the base scenario (raises SweepError)."""
-    check_run_count(spec)  # first: nothing expanded or allocated yet
+    key path and value against the base scenario (raises SweepError); the runs
+    load_sweep already checked are returned as they are."""
+    if spec.runs is not None:
+        return spec.runs
+    total = check_run_count(spec)  # first: nothing expanded or allocated yet
+    # Checking a run takes ~0.1 s: a large sweep says how far its check has come.
+    progress = ProgressBar(total, f"checking {spec.name}", unit="runs") if total >= 200 else None
     base = _checked("base", parse_scenario, spec.base_text, str(spec.base_path))
     fixed = [
         (concrete, value)
@@ -310,6 +319,10 @@ def expand(spec: SweepSpec) -> list[RunSpec]:
         overrides += _perturbations(rng, spec.perturbations, params)
         _checked(f"run {index} ({params})", apply_overrides, base, overrides)
         runs.append(RunSpec(index, run_key(spec.base_text, overrides), params, overrides))
+        if progress is not None:
+            progress.update(index + 1)
+    if progress is not None:
+        progress.close()
     return runs
 
 
