@@ -337,7 +337,8 @@ class HelperWork(LeafSystem):
     of t_n over its step, so the step's work is f_n . (p_{n+1} - p_n) per hand. Output
     helper_spent (4): [work J, its positive part J (per step, max(work, 0)), impulse
     N s (sum of |f_l| + |f_r| times the step), peak |f| of either hand N], over the
-    steps taken so far."""
+    steps taken so far. The hands' positions are read (and kept) only at the steps
+    that begin or end under a pull."""
 
     def __init__(self, step_s: float):
         super().__init__()
@@ -358,15 +359,25 @@ class HelperWork(LeafSystem):
         output.SetFromVector(context.get_discrete_state(self._memory).value()[:4])
 
     def _Update(self, context: Context, discrete_state) -> None:
-        memory = context.get_discrete_state(self._memory).value().copy()
-        p = self._positions.Eval(context)
-        if memory[16]:  # the step just taken, under the pull held since the last one
+        # In place (discrete_state holds the current values): a plant step's Python is
+        # the closed loop's cost, so no numpy temporaries where floats do (the norms'
+        # sums in numpy's order, (a + b) + c: bitwise the same totals).
+        memory = discrete_state.get_mutable_value(self._memory)
+        F = self._wrenches.Eval(context)
+        pulled = np.count_nonzero(F) > 0
+        held = memory[16] and np.count_nonzero(memory[10:16]) > 0
+        # The hands' positions only where a pull was held over the step just taken or is
+        # held over the next: without one a step spends nothing, whatever they did.
+        p = self._positions.Eval(context) if held or pulled else None
+        if held:  # the step just taken, under the pull held since the last one
             work = float(memory[10:16] @ (p - memory[4:10]))
             memory[0] += work
             memory[1] += max(work, 0.0)
-            held = np.linalg.norm(memory[10:16].reshape(2, 3), axis=1)
-            memory[2] += held.sum() * self._step_s
-            memory[3] = max(memory[3], held.max())
-        F = self._wrenches.Eval(context)
-        memory[4:10], memory[10:16], memory[16] = p, np.r_[F[3:6], F[9:12]], 1.0
-        discrete_state.set_value(self._memory, memory)
+            fx, fy, fz, gx, gy, gz = memory[10:16].tolist()
+            held_l = math.sqrt((fx * fx + fy * fy) + fz * fz)
+            held_r = math.sqrt((gx * gx + gy * gy) + gz * gz)
+            memory[2] += (held_l + held_r) * self._step_s
+            memory[3] = max(memory[3], max(held_l, held_r))
+        if p is not None:
+            memory[4:10] = p
+        memory[10:13], memory[13:16], memory[16] = F[3:6], F[9:12], 1.0
