@@ -57,7 +57,7 @@ def spatial_forces(
     pulled hands only (none while nobody pulls: the plant then has nothing to apply)."""
     pulled = []
     for force, f in zip(applied, (hand_wrenches_W[3:6], hand_wrenches_W[9:12])):
-        if f.any():
+        if np.count_nonzero(f):
             force.F_Bq_W = SpatialForce(np.zeros(3), f)
             pulled.append(force)
     return pulled
@@ -256,6 +256,18 @@ class HumanWrenchSource(LeafSystem):
         # its wrenches, because the integrator sets each step's end time twice
         # (its last stage, then the step's end), which Drake counts as a change.
         self._last_scripted: tuple[float, np.ndarray] | None = None
+        # The pulls as _wrenches sums them: (start, duration, ramp, their rows of
+        # hand_wrenches_W, force).
+        self._pulls = [
+            (
+                pull.start_s,
+                pull.duration_s,
+                pull.ramp_s,
+                slice(6 * HANDS[pull.hand] + 3, 6 * HANDS[pull.hand] + 6),
+                np.asarray(pull.force_N, dtype=float),
+            )
+            for pull in (config.pulls if config.mode == "scripted" else [])
+        ]
         # Both outputs read one evaluation of the human per time (and state):
         # hand_wrenches_W itself, (12,).
         self._wrenches_cache = declare_cached(self, "hand wrenches", self._wrenches, prereq)
@@ -310,15 +322,21 @@ class HumanWrenchSource(LeafSystem):
 
     def _wrenches(self, context: Context) -> np.ndarray:
         """hand_wrenches_W (12,): [0, f_l, 0, f_r]."""
-        scripted = self._cfg.mode == "scripted"
-        if scripted and self._last_scripted is not None:
-            t, wrenches = self._last_scripted
-            if t == context.get_time():
-                return wrenches
+        if self._cfg.mode != "scripted":
+            wrenches = np.zeros(12)
+            wrenches.reshape(2, 6)[:, 3:] = self._forces(context)
+            return wrenches
+        t = context.get_time()
+        if self._last_scripted is not None and self._last_scripted[0] == t:
+            return self._last_scripted[1]
+        # scripted_forces' sums, straight into the wrenches (a pull at scale 0 adds
+        # nothing: no entry is ever -0.0).
         wrenches = np.zeros(12)
-        wrenches.reshape(2, 6)[:, 3:] = self._forces(context)
-        if scripted:
-            self._last_scripted = context.get_time(), wrenches
+        for start_s, duration_s, ramp_s, rows, force in self._pulls:
+            scale = trapezoid(t, start_s, duration_s, ramp_s)
+            if scale != 0.0:
+                wrenches[rows] += scale * force
+        self._last_scripted = t, wrenches
         return wrenches
 
     def _CalcWrenches(self, context: Context, output: BasicVector) -> None:

@@ -179,7 +179,7 @@ class ControllerModel(LeafSystem):
         frames = self._frames.get(commands.active)
         if frames is None:
             frames = self._frames[commands.active] = active_frames(self.specs, commands.active)
-        pulled = bool(self._hands.Eval(context).any())
+        pulled = np.count_nonzero(self._hands.Eval(context)) > 0
         return self.kinematics.calc(self._state.Eval(context), frames, HANDS if pulled else ())
 
     def _CalcEstimate(self, context: Context, output: BasicVector) -> None:

@@ -56,7 +56,7 @@ from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
 from drake_standup.caching import declare_cached
 from drake_standup.config import RESPONSES, ComplianceConfig, ControllerConfig
-from drake_standup.control.spatial import yaw_pitch_rotation
+from drake_standup.control.spatial import cross, yaw_pitch_rotation
 from drake_standup.control.terms import RobotTerms
 from drake_standup.payloads import COM_REFERENCE, HAND_WRENCHES
 from drake_standup.phases import PhaseTable
@@ -276,7 +276,7 @@ class ReferenceGenerator:
         target = np.zeros(3)
         if state.lean and tau_hand is not None:
             wrench = tau_hand[:6].copy()
-            wrench[:3] -= np.cross(terms.p_BoCom, wrench[3:])
+            wrench[:3] -= cross(terms.p_BoCom, wrench[3:])
             target = static_lean(
                 wrench,
                 float(terms.p_WCom[2]),
@@ -522,7 +522,7 @@ class TaskReferenceGenerator(LeafSystem):
             self._terms.Eval(context),
             standup_state,
             self._reference.Eval(context),
-            F_hand_W if F_hand_W.any() else None,
+            F_hand_W if np.count_nonzero(F_hand_W) else None,
             state.get_value(self._integral),
             state.get_value(self._posture),
             state.get_value(self._lean),
