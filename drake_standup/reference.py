@@ -64,6 +64,9 @@ class CoMReferenceGenerator(LeafSystem):
         self._psi_dot = self.DeclareVectorInputPort("psi_dot", 1)
         self._psi_ddot = self.DeclareVectorInputPort("psi_ddot", 1)
         self._segment = self.DeclareVectorInputPort("segment", SEGMENT_SIZE)
+        # Where psi is outside its segment the path is the segment's start or end:
+        # (segment bytes, end) -> path(), computed once (most of a run; read only).
+        self._clamped: dict[tuple[bytes, bool], tuple[np.ndarray, ...]] = {}
         # The path depends on psi and the segment only: evaluated once per
         # change of them for all four outputs.
         self._path = declare_cached(
@@ -90,8 +93,20 @@ class CoMReferenceGenerator(LeafSystem):
         """x_d, d_psi x_d, d2_psi x_d and the progress along the segment at psi."""
         segment = self._segment.Eval(context)
         psi = self._psi.Eval(context)[0]
-        progress = min(max((psi - segment[0]) / segment[1], 0.0), 1.0)
-        return (*path(segment, psi), progress)
+        tau = (psi - segment[0]) / segment[1]
+        progress = min(max(tau, 0.0), 1.0)
+        if not (tau <= 0.0 or tau >= 1.0):  # min_jerk's own test (NaN: computed)
+            return (*path(segment, psi), progress)
+        # min_jerk is constant there: path() of the segment at its start or end.
+        key = (segment.tobytes(), tau >= 1.0)
+        clamped = self._clamped.get(key)
+        if clamped is None:
+            if len(self._clamped) > 64:
+                self._clamped.clear()
+            clamped = self._clamped[key] = path(segment, psi)
+            for array in clamped:
+                array.flags.writeable = False
+        return (*clamped, progress)
 
     def _CalcReference(self, context: Context, output: BasicVector) -> None:
         x_d, d_x, dd_x, _ = self._path.Eval(context)
