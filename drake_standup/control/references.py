@@ -286,7 +286,8 @@ class ReferenceGenerator:
             target[0] = min(
                 max(target[0], -self._config.lean_max_back_m), self._config.lean_max_forward_m
             )
-        if not (target.any() or lean.any()):
+        # count_nonzero: .any() of a 3-vector costs ~5x more (NaN counts in both).
+        if not (np.count_nonzero(target) or np.count_nonzero(lean)):
             return lean
         return lean + self._lean_blend * (target - lean)
 
@@ -359,7 +360,7 @@ class ReferenceGenerator:
         state = self.schedule[standup_state]
         tau_hand = None if F_hand_W is None else terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
         lean = self._lean(terms, state, tau_hand, lean_W)
-        if lean.any():
+        if np.count_nonzero(lean):
             # Leaning is tilting about the feet: the CoM target keeps its distance from
             # the floor point below the unleaned target, so it drops as it leans (2 cm at
             # a 15 cm lean); an unchanged height asked for legs longer than straight.
@@ -370,7 +371,7 @@ class ReferenceGenerator:
         compliance = np.zeros(6) if compliance is None else compliance
         pulled = F_hand_W is not None and response == COMPLIANT
         next_compliance = compliance
-        if pulled or compliance.any():
+        if pulled or np.count_nonzero(compliance):
             anchor = np.zeros(3)
             if pulled:
                 bounds = self._offset_bounds(state, F_hand_W, terms.mass_kg * self._gravity_mps2)

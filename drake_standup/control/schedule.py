@@ -168,7 +168,7 @@ class ContactScheduler(LeafSystem):
         if mode.state < self._first_release:  # every pad seated: following its commands
             return self._seated[phase_seat_hold(mode, self._table)], np.concatenate((last, last))
         loads = seat_loads(mode, context.get_time(), self._releases)
-        if not loads.any():  # every pad released (NaN, seated, counts as nonzero)
+        if not np.count_nonzero(loads):  # every pad released (NaN, seated, counts as nonzero)
             return self._released, np.concatenate((memory[:3], last))
         unload_from = next_unload_from(memory[:3], last, loads)
         measured = self._measured.Eval(context)
