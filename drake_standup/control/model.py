@@ -156,5 +156,5 @@ class ControllerModel:
         frames = self._frames.get(commands.active)
         if frames is None:
             frames = self._frames[commands.active] = active_frames(self.specs, commands.active)
-        pulled = bool(hand_wrenches_W.any())
+        pulled = np.count_nonzero(hand_wrenches_W) > 0
         return self.kinematics.calc(robot_state, frames, HANDS if pulled else ())

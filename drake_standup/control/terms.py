@@ -28,8 +28,8 @@ import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 
-from drake_standup.control.spatial import cross, rotation_from_quaternion
 from drake_standup.robot.icub import Robot
+from drake_standup.robot.spatial import cross, rotation_from_quaternion
 
 BASE_BODY = "root_link"
 

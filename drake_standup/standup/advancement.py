@@ -51,6 +51,10 @@ from drake_standup.config import AdvancementConfig
 from drake_standup.control.smooth import smoothstep
 from drake_standup.ports.caching import declare_cached
 
+# The tangent of a phase that holds psi = t (read only).
+_NO_TANGENT = np.zeros(3)
+_NO_TANGENT.flags.writeable = False
+
 
 def helpfulness(tangent: np.ndarray, omega_f: np.ndarray, eps: float) -> float:
     """alpha: Omega f projected on the desired direction (0 where the path stops)."""
@@ -190,7 +194,7 @@ class TrajectoryAdvancement(LeafSystem):
         if self._response.Eval(context)[0] > 0.5:  # stiff or compliant: psi = t
             return 1.0, helpfulness(tangent, self._omega_f.Eval(context), self._config.eps)
         if self._advances.Eval(context)[0] < 0.5:
-            tangent = np.zeros(3)  # a phase that holds psi = t: nothing to advance along
+            tangent = _NO_TANGENT  # a phase that holds psi = t: nothing to advance along
         # The velocity, the lead and the progress only while the interaction helps (a
         # few seconds of a stand-up).
         return psi_dot_law(
@@ -208,8 +212,10 @@ class TrajectoryAdvancement(LeafSystem):
         return (self._law(context)[0] - psi_dot) / self._config.psi_ddot_filter_s
 
     def DoCalcTimeDerivatives(self, context: Context, derivatives: ContinuousState) -> None:
+        # _psi_ddot inlined (the integrator asks twice a step): the same arithmetic.
         psi_dot = context.get_continuous_state_vector().GetAtIndex(1)
-        derivatives.get_mutable_vector().SetFromVector([psi_dot, self._psi_ddot(context)])
+        psi_ddot = (self._law_cache.Eval(context)[0] - psi_dot) / self._config.psi_ddot_filter_s
+        derivatives.get_mutable_vector().SetFromVector([psi_dot, psi_ddot])
 
     def _CalcPsi(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, context.get_continuous_state_vector().GetAtIndex(0))

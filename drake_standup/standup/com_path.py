@@ -27,6 +27,7 @@ from drake_standup.control.targets import StateReferences
 from drake_standup.control.terms import RobotTerms
 from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.balance import static_lean
+from drake_standup.robot.spatial import cross
 
 SEGMENT_SIZE = 8  # [psi_entry, T, x_start (3), delta (3)]
 
@@ -68,6 +69,9 @@ class CoMReferenceGenerator(LeafSystem):
         self._psi_dot = self.DeclareVectorInputPort("psi_dot", 1)
         self._psi_ddot = self.DeclareVectorInputPort("psi_ddot", 1)
         self._segment = self.DeclareVectorInputPort("segment", SEGMENT_SIZE)
+        # Where psi is outside its segment the path is the segment's start or end:
+        # (segment bytes, end) -> path(), computed once (most of a run; read only).
+        self._clamped: dict[tuple[bytes, bool], tuple[np.ndarray, ...]] = {}
         # The path depends on psi and the segment only: evaluated once per
         # change of them for all four outputs.
         self._path = declare_cached(
@@ -94,8 +98,20 @@ class CoMReferenceGenerator(LeafSystem):
         """x_d, d_psi x_d, d2_psi x_d and the progress along the segment at psi."""
         segment = self._segment.Eval(context)
         psi = self._psi.Eval(context)[0]
-        progress = min(max((psi - segment[0]) / segment[1], 0.0), 1.0)
-        return (*path(segment, psi), progress)
+        tau = (psi - segment[0]) / segment[1]
+        progress = min(max(tau, 0.0), 1.0)
+        if not (tau <= 0.0 or tau >= 1.0):  # min_jerk's own test (NaN: computed)
+            return (*path(segment, psi), progress)
+        # min_jerk is constant there: path() of the segment at its start or end.
+        key = (segment.tobytes(), tau >= 1.0)
+        clamped = self._clamped.get(key)
+        if clamped is None:
+            if len(self._clamped) > 64:
+                self._clamped.clear()
+            clamped = self._clamped[key] = path(segment, psi)
+            for array in clamped:
+                array.flags.writeable = False
+        return (*clamped, progress)
 
     def _CalcReference(self, context: Context, output: BasicVector) -> None:
         x_d, d_x, dd_x, _ = self._path.Eval(context)
@@ -166,7 +182,7 @@ class CoMTarget:
         derivatives; tau_hand = J_h^T F_hand (None: no pull); lean_W, compliance: their
         values before the tick; compliant: the response yields to the pull."""
         lean = self._lean(terms, state, tau_hand, lean_W)
-        if lean.any():
+        if np.count_nonzero(lean):
             # Leaning is tilting about the feet: the CoM target keeps its distance from
             # the floor point below the unleaned target, so it drops as it leans (2 cm at
             # a 15 cm lean); an unchanged height asked for legs longer than straight.
@@ -176,7 +192,7 @@ class CoMTarget:
             com_reference[2] = math.sqrt(max(height * height - lean[0] ** 2 - lean[1] ** 2, 0.0))
         pulled = F_hand_W is not None and compliant
         next_compliance = compliance
-        if pulled or compliance.any():
+        if pulled or np.count_nonzero(compliance):
             anchor = np.zeros(3)
             if pulled:
                 bounds = self.offset_bounds(state, F_hand_W, terms.mass_kg * self._gravity_mps2)
@@ -208,7 +224,7 @@ class CoMTarget:
         target = np.zeros(3)
         if state.lean and tau_hand is not None:
             wrench = tau_hand[:6].copy()
-            wrench[:3] -= np.cross(terms.p_BoCom, wrench[3:])
+            wrench[:3] -= cross(terms.p_BoCom, wrench[3:])
             target = static_lean(
                 wrench,
                 float(terms.p_WCom[2]),
@@ -218,7 +234,8 @@ class CoMTarget:
             target[0] = min(
                 max(target[0], -self._config.lean_max_back_m), self._config.lean_max_forward_m
             )
-        if not (target.any() or lean.any()):
+        # count_nonzero: .any() of a 3-vector costs ~5x more (NaN counts in both).
+        if not (np.count_nonzero(target) or np.count_nonzero(lean)):
             return lean
         return lean + self._lean_blend * (target - lean)
 

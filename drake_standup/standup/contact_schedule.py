@@ -130,7 +130,7 @@ class ContactSchedule:
         if mode.state < self._first_release:  # every pad seated: following its commands
             return self._seated[phase_seat_hold(mode, self._table)], np.concatenate((last, last))
         loads = seat_loads(mode, t, self._releases)
-        if not loads.any():  # every pad released (NaN, seated, counts as nonzero)
+        if not np.count_nonzero(loads):  # every pad released (NaN, seated, counts as nonzero)
             return self._released, np.concatenate((memory[:3], last))
         unload_from = next_unload_from(memory[:3], last, loads)
         commands = contact_commands(

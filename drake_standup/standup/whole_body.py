@@ -137,7 +137,7 @@ class StandupWholeBodyController(LeafSystem):
             terms,
             mode.state,
             self._input("com_reference", context),
-            hands if hands.any() else None,
+            hands if np.count_nonzero(hands) else None,
             state.get_value(self._integral),
             state.get_value(self._posture),
             state.get_value(self._lean),

@@ -57,7 +57,7 @@ def spatial_forces(
     pulled hands only (none while nobody pulls: the plant then has nothing to apply)."""
     pulled = []
     for force, f in zip(applied, (hand_wrenches_W[3:6], hand_wrenches_W[9:12])):
-        if f.any():
+        if np.count_nonzero(f):
             force.F_Bq_W = SpatialForce(np.zeros(3), f)
             pulled.append(force)
     return pulled
@@ -256,6 +256,18 @@ class HumanWrenchSource(LeafSystem):
         # its wrenches, because the integrator sets each step's end time twice
         # (its last stage, then the step's end), which Drake counts as a change.
         self._last_scripted: tuple[float, np.ndarray] | None = None
+        # The pulls as _wrenches sums them: (start, duration, ramp, their rows of
+        # hand_wrenches_W, force).
+        self._pulls = [
+            (
+                pull.start_s,
+                pull.duration_s,
+                pull.ramp_s,
+                slice(6 * HANDS[pull.hand] + 3, 6 * HANDS[pull.hand] + 6),
+                np.asarray(pull.force_N, dtype=float),
+            )
+            for pull in (config.pulls if config.mode == "scripted" else [])
+        ]
         # Both outputs read one evaluation of the human per time (and state):
         # hand_wrenches_W itself, (12,).
         self._wrenches_cache = declare_cached(self, "hand wrenches", self._wrenches, prereq)
@@ -310,15 +322,21 @@ class HumanWrenchSource(LeafSystem):
 
     def _wrenches(self, context: Context) -> np.ndarray:
         """hand_wrenches_W (12,): [0, f_l, 0, f_r]."""
-        scripted = self._cfg.mode == "scripted"
-        if scripted and self._last_scripted is not None:
-            t, wrenches = self._last_scripted
-            if t == context.get_time():
-                return wrenches
+        if self._cfg.mode != "scripted":
+            wrenches = np.zeros(12)
+            wrenches.reshape(2, 6)[:, 3:] = self._forces(context)
+            return wrenches
+        t = context.get_time()
+        if self._last_scripted is not None and self._last_scripted[0] == t:
+            return self._last_scripted[1]
+        # scripted_forces' sums, straight into the wrenches (a pull at scale 0 adds
+        # nothing: no entry is ever -0.0).
         wrenches = np.zeros(12)
-        wrenches.reshape(2, 6)[:, 3:] = self._forces(context)
-        if scripted:
-            self._last_scripted = context.get_time(), wrenches
+        for start_s, duration_s, ramp_s, rows, force in self._pulls:
+            scale = trapezoid(t, start_s, duration_s, ramp_s)
+            if scale != 0.0:
+                wrenches[rows] += scale * force
+        self._last_scripted = t, wrenches
         return wrenches
 
     def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
@@ -337,7 +355,8 @@ class HelperWork(LeafSystem):
     of t_n over its step, so the step's work is f_n . (p_{n+1} - p_n) per hand. Output
     helper_spent (4): [work J, its positive part J (per step, max(work, 0)), impulse
     N s (sum of |f_l| + |f_r| times the step), peak |f| of either hand N], over the
-    steps taken so far."""
+    steps taken so far. The hands' positions are read (and kept) only at the steps
+    that begin or end under a pull."""
 
     def __init__(self, step_s: float):
         super().__init__()
@@ -358,15 +377,25 @@ class HelperWork(LeafSystem):
         output.SetFromVector(context.get_discrete_state(self._memory).value()[:4])
 
     def _Update(self, context: Context, discrete_state) -> None:
-        memory = context.get_discrete_state(self._memory).value().copy()
-        p = self._positions.Eval(context)
-        if memory[16]:  # the step just taken, under the pull held since the last one
+        # In place (discrete_state holds the current values): a plant step's Python is
+        # the closed loop's cost, so no numpy temporaries where floats do (the norms'
+        # sums in numpy's order, (a + b) + c: bitwise the same totals).
+        memory = discrete_state.get_mutable_value(self._memory)
+        F = self._wrenches.Eval(context)
+        pulled = np.count_nonzero(F) > 0
+        held = memory[16] and np.count_nonzero(memory[10:16]) > 0
+        # The hands' positions only where a pull was held over the step just taken or is
+        # held over the next: without one a step spends nothing, whatever they did.
+        p = self._positions.Eval(context) if held or pulled else None
+        if held:  # the step just taken, under the pull held since the last one
             work = float(memory[10:16] @ (p - memory[4:10]))
             memory[0] += work
             memory[1] += max(work, 0.0)
-            held = np.linalg.norm(memory[10:16].reshape(2, 3), axis=1)
-            memory[2] += held.sum() * self._step_s
-            memory[3] = max(memory[3], held.max())
-        F = self._wrenches.Eval(context)
-        memory[4:10], memory[10:16], memory[16] = p, np.r_[F[3:6], F[9:12]], 1.0
-        discrete_state.set_value(self._memory, memory)
+            fx, fy, fz, gx, gy, gz = memory[10:16].tolist()
+            held_l = math.sqrt((fx * fx + fy * fy) + fz * fz)
+            held_r = math.sqrt((gx * gx + gy * gy) + gz * gz)
+            memory[2] += (held_l + held_r) * self._step_s
+            memory[3] = max(memory[3], max(held_l, held_r))
+        if p is not None:
+            memory[4:10] = p
+        memory[10:13], memory[13:16], memory[16] = F[3:6], F[9:12], 1.0

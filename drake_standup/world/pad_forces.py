@@ -16,24 +16,39 @@ def pad_forces(results: ContactResults, pad_ids: dict[GeometryId, int], n_pads: 
     (fallback): contact_force acts on body B. Signs follow from which side of
     the pair the pad is on.
     """
-    forces = np.zeros((n_pads, 3))
+    # Summed in floats (the same additions as numpy's rows, in the same order): a
+    # row's += on a 3-vector costs more than the contact's own reads.
+    forces = [[0.0, 0.0, 0.0] for _ in range(n_pads)]
+    get = pad_ids.get
     for i in range(results.num_hydroelastic_contacts()):
         info = results.hydroelastic_contact_info(i)
         surface = info.contact_surface()
-        f = info.F_Ac_W().translational()
-        if (row := pad_ids.get(surface.id_M())) is not None:
-            forces[row] += f
-        if (row := pad_ids.get(surface.id_N())) is not None:
-            forces[row] -= f
+        fx, fy, fz = info.F_Ac_W().translational().tolist()
+        if (row := get(surface.id_M())) is not None:
+            sums = forces[row]
+            sums[0] += fx
+            sums[1] += fy
+            sums[2] += fz
+        if (row := get(surface.id_N())) is not None:
+            sums = forces[row]
+            sums[0] -= fx
+            sums[1] -= fy
+            sums[2] -= fz
     for i in range(results.num_point_pair_contacts()):
         info = results.point_pair_contact_info(i)
         pair = info.point_pair()
-        f = info.contact_force()
-        if (row := pad_ids.get(pair.id_B)) is not None:
-            forces[row] += f
-        if (row := pad_ids.get(pair.id_A)) is not None:
-            forces[row] -= f
-    return forces
+        fx, fy, fz = info.contact_force().tolist()
+        if (row := get(pair.id_B)) is not None:
+            sums = forces[row]
+            sums[0] += fx
+            sums[1] += fy
+            sums[2] += fz
+        if (row := get(pair.id_A)) is not None:
+            sums = forces[row]
+            sums[0] -= fx
+            sums[1] -= fy
+            sums[2] -= fz
+    return np.array(forces).reshape(n_pads, 3)
 
 
 class ContactForceReporter(LeafSystem):

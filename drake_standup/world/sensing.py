@@ -17,6 +17,7 @@ from pydrake.systems.framework import BasicVector, Context, LeafSystem
 from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.balance import static_lean
 from drake_standup.robot.icub import Robot
+from drake_standup.robot.spatial import cross
 from drake_standup.world.human import TASK_FRAMES
 
 
@@ -66,9 +67,10 @@ def standing_lean(
     the edge of the soles' boxes (half their length forward and back, half the span of
     both boxes sideways). None if the pull lifts the robot."""
     F = np.asarray(hand_wrenches_W).reshape(2, 6)
-    wrench = np.concatenate(
-        [F[:, :3].sum(axis=0) + np.cross(support.hands_m, F[:, 3:]).sum(axis=0), F[:, 3:].sum(0)]
-    )
+    # The rows summed as numpy sums them (row 0 + row 1); spatial.cross for np.cross.
+    hands = support.hands_m
+    moment = cross(hands[0], F[0, 3:]) + cross(hands[1], F[1, 3:])
+    wrench = np.concatenate([F[0, :3] + F[1, :3] + moment, F[0, 3:] + F[1, 3:]])
     if weight_N - wrench[5] <= 0.0:
         return None
     d = static_lean(wrench, support.com_height_m, weight_N, math.inf)
@@ -168,7 +170,14 @@ class RobotSensing(LeafSystem):
         """The private plant context at robot_state (check: unless it is there
         already, so that its kinematics are not computed twice)."""
         state = self._state.Eval(context)
-        if not (check and np.array_equal(state, self._context_state)):
+        last = self._context_state
+        # The same bytes are the same state (a cheap test first; array_equal decides
+        # otherwise, e.g. -0.0 == 0.0, as before).
+        if not (
+            check
+            and last is not None
+            and (state.tobytes() == last.tobytes() or np.array_equal(state, last))
+        ):
             self._plant.SetPositionsAndVelocities(self._context, self._instance, state)
             self._context_state = state
 
@@ -216,7 +225,11 @@ class RobotSensing(LeafSystem):
 
     def _CalcUsage(self, context: Context, output: BasicVector) -> None:
         F = self._wrenches.Eval(context)
-        usage = standing_pull_usage(F, self._mass_kg * self._g, self._standing) if F.any() else 0.0
+        usage = (
+            standing_pull_usage(F, self._mass_kg * self._g, self._standing)
+            if np.count_nonzero(F)
+            else 0.0
+        )
         output.SetAtIndex(0, usage)
 
     def _CalcOmegaF(self, context: Context, output: BasicVector) -> None:

@@ -11,9 +11,9 @@ import math
 import numpy as np
 
 from drake_standup.control.qp_types import QpLayout, Task
-from drake_standup.control.spatial import rotation_vector, yaw_pitch_rotation
 from drake_standup.control.targets import TaskReferences
 from drake_standup.control.terms import RobotTerms
+from drake_standup.robot.spatial import rotation_vector, yaw_pitch_rotation
 
 
 class BaseOrientationTask(Task):

@@ -18,9 +18,9 @@ import numpy as np
 from drake_standup.config import ControllerConfig
 from drake_standup.control.qp_types import ContactMap, QpLayout, Task
 from drake_standup.control.smooth import smoothstep
-from drake_standup.control.spatial import cross, skew
 from drake_standup.control.targets import TaskReferences
 from drake_standup.control.terms import RobotTerms
+from drake_standup.robot.spatial import cross, skew
 
 
 class MomentumTask(Task):
