@@ -92,7 +92,8 @@ def test_the_qp_plans_what_the_plant_does_while_the_robot_leaves_the_seat():
     scenario = load_scenario(SCENARIO_DIR / "unassisted.yaml")
     run = prepare(scenario)
     plant = run.built.station.plant
-    controller = run.built.controller
+    standup = run.built.diagram.GetSubsystemByName("standup_controller")
+    controller = standup.GetSubsystemByName("controller")  # the whole-body tick's system
     plant_context = plant.GetMyContextFromRoot(run.root_context)
     controller_context = controller.GetMyContextFromRoot(run.root_context)
     names = ("l_hip_pitch", "r_hip_pitch", "torso_pitch")
@@ -108,7 +109,8 @@ def test_the_qp_plans_what_the_plant_does_while_the_robot_leaves_the_seat():
         v0 = plant.GetVelocities(plant_context)[rows].copy()
         planned = np.zeros(len(rows))
         for _ in range(15):
-            planned += controller.CalcTick(controller_context).solution.vdot[rows] * step
+            tick, _ = controller.calc_tick(controller_context)
+            planned += tick.solution.vdot[rows] * step
             t += step
             run.simulator.AdvanceTo(t)
         angle = hip.get_angle(plant_context)
