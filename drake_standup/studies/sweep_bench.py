@@ -17,32 +17,21 @@ import json
 import os
 import platform
 import shutil
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 from drake_standup.config.arguments import OneLineErrorParser
+from drake_standup.studies.bench_measurements import git_state
 from drake_standup.studies.sweep import run_sweep
 from drake_standup.studies.sweep_file import load_sweep
 from drake_standup.studies.sweep_table import simulation_rows
 
 
 def _git() -> dict:
-    def run(*args: str) -> str:
-        try:
-            out = subprocess.run(
-                ["git", *args],
-                cwd=Path(__file__).parent,
-                capture_output=True,
-                text=True,
-                check=True,
-            )
-        except (OSError, subprocess.CalledProcessError):
-            return ""
-        return out.stdout.strip()
-
-    return {"commit": run("rev-parse", "--short", "HEAD"), "dirty": bool(run("status", "-s"))}
+    """The commit (short) and whether the tree had uncommitted changes."""
+    state = git_state()
+    return {"commit": (state["commit"] or "")[:7], "dirty": bool(state["uncommitted"])}
 
 
 def main(argv: list[str] | None = None) -> int:
