@@ -479,12 +479,14 @@ def test_scene_gives_the_motors_their_inertia_per_setting(model, setting, expect
     """The scenario's plant (which the controller's model is) has the knee's motor
     reflected inertia, 100^2 x 0.0827e-4 kg m^2, exactly where the setting says."""
     from drake_standup.config import load_scenario
+    from drake_standup.standup.plan import feet_reach
     from drake_standup.world.station import make_station
 
     overrides = [("robot.model", model)]
     if setting is not None:
         overrides.append(("robot.reflected_inertia", setting))
-    plant = make_station(load_scenario(None, overrides)).plant
+    scenario = load_scenario(None, overrides)
+    plant = make_station(scenario, feet_reach(scenario.controller)).plant
     knee = plant.GetJointActuatorByName("l_knee")
     context = plant.CreateDefaultContext()
     reflected = knee.rotor_inertia(context) * knee.gear_ratio(context) ** 2

@@ -290,9 +290,10 @@ def _hand_positions(scenario, sig) -> np.ndarray:
     from pydrake.common.eigen_geometry import Quaternion
     from pydrake.math import RigidTransform
 
+    from drake_standup.standup.plan import feet_reach
     from drake_standup.world.station import make_station
 
-    station = make_station(scenario)
+    station = make_station(scenario, feet_reach(scenario.controller))
     plant, robot = station.plant, station.robot
     context = plant.CreateDefaultContext()
     base = plant.GetBodyByName("root_link", robot.model_instance)

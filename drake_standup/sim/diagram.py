@@ -19,7 +19,7 @@ from drake_standup.config import RESPONSES, Scenario, validate
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.robot.icub import actuated_joints
 from drake_standup.sim.visuals import StandupVisuals
-from drake_standup.standup.plan import StandupPlan, make_plan
+from drake_standup.standup.plan import StandupPlan, feet_reach, make_plan
 from drake_standup.standup.standup_controller import StandupController, make_standup_controller
 from drake_standup.world.human import HelperWork, HumanWrenchSource
 from drake_standup.world.scene import Scene, set_seated_state
@@ -92,7 +92,9 @@ def build_diagram(
     hold = scenario.seat_hold
     seat_hold = controller == "seat_hold"
     station = make_station(
-        scenario, (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad) if seat_hold else None
+        scenario,
+        feet_reach(scenario.controller),
+        (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad) if seat_hold else None,
     )
     plan = make_plan(scenario, station)
     builder = DiagramBuilder()

@@ -10,9 +10,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from drake_standup.config import Scenario
+from drake_standup.config import ControllerConfig, Scenario
 from drake_standup.config.phases import PHASES, SEAT_PADS, PhaseTable, resolve_com_heights
 from drake_standup.world.scene import erect_com_height_m
+from drake_standup.world.sensing import FeetReach
 from drake_standup.world.station import Station
 
 
@@ -44,6 +45,16 @@ class StandupPlan:
     def stance_states(self) -> set[int]:
         """The states whose phase ends on the legs' posture (the stance tasks act)."""
         return {k for k, phase in enumerate(self.table, start=1) if phase.stance}
+
+
+def feet_reach(config: ControllerConfig) -> FeetReach:
+    """How far the controller leans the standing CoM and its soles' CoP boxes, for the
+    world's measure of what a pull asks of the standing feet."""
+    return FeetReach(
+        lean_m=(config.lean_max_forward_m, config.lean_max_back_m, config.lean_max_m),
+        cop_x_m=tuple(config.foot_cop_x_m),
+        cop_y_m=tuple(config.foot_cop_y_m),
+    )
 
 
 def _posture_key(posture_rad: dict[str, float]) -> tuple:

@@ -42,11 +42,22 @@ def thigh_points(robot: Robot) -> dict[str, np.ndarray]:
 
 
 @dataclass(frozen=True)
+class FeetReach:
+    """How far the stand-up may lean the standing CoM (forward, back, sideways) and each
+    sole's CoP box, m: the controller's limits, which the caller hands the world
+    (standup/plan.py: feet_reach)."""
+
+    lean_m: tuple[float, float, float]
+    cop_x_m: tuple[float, float]
+    cop_y_m: tuple[float, float]
+
+
+@dataclass(frozen=True)
 class StandingSupport:
     """What the standing robot can hold, for standing_pull_usage: its erect CoM height,
     its hands' and soles' origins from the CoM (2 x 3 each, left and right; scene.
-    standing_offsets_m), how far the controller leans its CoM (forward, back, sideways:
-    lean_max_*) and each sole's CoP box (controller.foot_cop_*_m), m."""
+    standing_offsets_m), how far the stand-up leans its CoM (forward, back, sideways)
+    and each sole's CoP box (FeetReach), m."""
 
     com_height_m: float
     hands_m: np.ndarray

@@ -1,4 +1,4 @@
-"""make_station(scenario): the world the stand-up controller acts in, as one diagram.
+"""make_station(scenario, feet): the world the stand-up controller acts in, as one diagram.
 
 The plant with the iCub, the chair and the floor (scene.py), the contact forces on the
 robot's pads (contacts.py) and the leg force sensors made of them, what the robot senses
@@ -45,7 +45,13 @@ from drake_standup.world.scene import (
     erect_com_height_m,
     standing_offsets_m,
 )
-from drake_standup.world.sensing import RobotSensing, StandingSupport, heel_points, thigh_points
+from drake_standup.world.sensing import (
+    FeetReach,
+    RobotSensing,
+    StandingSupport,
+    heel_points,
+    thigh_points,
+)
 
 # Pad groups as metrics.json reports them (plural where there are two).
 _GROUP_LABELS = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
@@ -83,8 +89,11 @@ class Station:
         )
 
 
-def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None) -> Station:
-    """The station of the module docstring; pd_gains: Drake's joint PD on every actuator
+def make_station(
+    scenario: Scenario, feet: FeetReach, pd_gains: tuple[float, float] | None = None
+) -> Station:
+    """The station of the module docstring; feet: how far the stand-up leans on the
+    standing feet (for standing_pull_usage); pd_gains: Drake's joint PD on every actuator
     (the seat-hold benchmark), with the desired_state input."""
     builder = DiagramBuilder()
     scene = add_scene(builder, scenario, pd_gains=pd_gains)
@@ -94,7 +103,7 @@ def make_station(scenario: Scenario, pd_gains: tuple[float, float] | None = None
     instance = robot.model_instance
     pad_groups, reporter = _add_pad_forces(builder, plant, robot)
     measured = _add_pushes_and_hand_sensors(builder, scenario, plant, robot)
-    standing, robot_state = _add_sensing(builder, scene, scenario, measured)
+    standing, robot_state = _add_sensing(builder, scene, scenario, feet, measured)
 
     builder.ExportInput(plant.get_actuation_input_port(instance), "actuation")
     if pd_gains is not None:
@@ -169,20 +178,24 @@ def _add_pushes_and_hand_sensors(
 
 
 def _add_sensing(
-    builder: DiagramBuilder, scene: Scene, scenario: Scenario, measured: OutputPort
+    builder: DiagramBuilder,
+    scene: Scene,
+    scenario: Scenario,
+    feet: FeetReach,
+    measured: OutputPort,
 ) -> tuple[StandingSupport, OutputPort]:
     """What the robot senses of itself (sensing.py), with what its standing feet can hold;
     returns that StandingSupport and the robot's state output."""
     plant, robot = scene.plant, scene.robot
-    rise, config = scenario.phases.rise, scenario.controller
+    rise = scenario.phases.rise
     hands, soles = standing_offsets_m(scene, scenario, rise.posture_rad)
     standing = StandingSupport(
         com_height_m=rise.com_height_m or erect_com_height_m(scene, scenario, rise.posture_rad),
         hands_m=hands,
         soles_m=soles,
-        lean_m=(config.lean_max_forward_m, config.lean_max_back_m, config.lean_max_m),
-        cop_x_m=tuple(config.foot_cop_x_m),
-        cop_y_m=tuple(config.foot_cop_y_m),
+        lean_m=feet.lean_m,
+        cop_x_m=feet.cop_x_m,
+        cop_y_m=feet.cop_y_m,
     )
     sensing = builder.AddNamedSystem(
         "sensing",
