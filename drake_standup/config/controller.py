@@ -32,7 +32,7 @@ class ControllerConfig:
     # 0.2473 rad lies below the URDF's 0.262 limit. rad.
     posture_limit_margin_rad: float = 0.05
     # Acceleration bounds stop every actuated joint at its limits within this horizon
-    # (control/tasks.py): without them the shoulders and the knees hit their stops. s.
+    # (control/tasks/): without them the shoulders and the knees hit their stops. s.
     joint_limit_horizon_s: float = 0.1
     # ... softly: a slack s per joint at the cost w s^2 (rad/s^2); hard bounds made the
     # QP infeasible where the soles pin the legs or the pull holds the shoulders.

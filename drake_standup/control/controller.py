@@ -3,7 +3,7 @@
 A plain object: each tick, from the controller's model at the robot's state (RobotTerms,
 control/model.py), the tick's task references (TaskReferences, control/targets.py) and
 the contact commands (ContactCommands, control/contacts.py), it solves one QP over
-[contact wrenches, vdot] with the task objects of control/tasks.py (control/qp.py) for
+[contact wrenches, vdot] with the task objects of control/tasks/ (control/qp.py) for
 the joint torques. The system that holds the torques and calls it once a tick is the
 stand-up's (standup/standup_controller.py); on a failed QP the last torques stay there.
 next_diagnostics packs a tick's DIAGNOSTICS.

@@ -55,7 +55,7 @@ def contact_specs(
     return [
         ContactSpec("seat", **friction, **seat_box, hold_point_m=tuple(p_SeatHinge.tolist())),
         # Held once the buttocks are off the seat, while the thighs carry load (flat while
-        # seated, by their normal while they unload: control/schedule.py).
+        # seated, by their normal while they unload: standup/contact_schedule.py).
         ContactSpec("l_thigh", **friction, **thigh_box),
         ContactSpec("r_thigh", **friction, **thigh_box),
         ContactSpec("l_sole", **friction, **foot_box),

@@ -18,11 +18,11 @@ The program, built once and refilled every tick:
                                                       k: a slip braked back to rest)
            K_c F_c <= 0,  f_z,c in [lo_c, hi_c]       each contact
            -tau_max <= T z + t0 <= tau_max            torque limits
-           vdot_min <= vdot <= vdot_max               joint limits (control/tasks.py)
+           vdot_min <= vdot <= vdot_max               joint limits (control/tasks/)
 
 The program holds only the contacts that are active: the controller keeps one per set
 of active contacts (its size, and so its solve time, shrinks once the seat is released).
-The tasks (A_k, b_k, w_k) are Task objects (control/tasks.py), consumed generically: the
+The tasks (A_k, b_k, w_k) are Task objects (control/tasks/), consumed generically: the
 ones active in the tick's standup state, each refreshed by its update(); the solver is a
 backend chosen by name (daqp, or Drake's OSQP / Clarabel).
 

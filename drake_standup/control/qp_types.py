@@ -1,7 +1,7 @@
 """The whole-body QP's types (the solver, WholeBodyQp, is control/qp.py): where each
 unknown sits in z = [F_1 .. F_nc, vdot] (QpLayout), the contact unknowns' map to
 generalized forces (ContactMap), the protocols of the cost's tasks and of the acceleration
-bounds (Task, AccelerationBounds; control/tasks.py makes them), a set of active tasks with
+bounds (Task, AccelerationBounds; control/tasks/ makes them), a set of active tasks with
 their constant cost precomputed (ActiveTasks), what a tick's contact plan asks of the
 program (QpContactBounds) and what it returns (QpSolution); as_slice, index arrays as
 slices where they can be."""
@@ -42,7 +42,7 @@ class QpLayout:
 
 class Task:
     """One least-squares objective, w ||A z[columns] - b||^2 (w: weight, a scalar or one
-    weight per row of A), in the modes active_states (None: every mode; control/tasks.py).
+    weight per row of A), in the modes active_states (None: every mode; control/tasks/).
 
     A task sets weight, columns, A and b when it is made and refreshes what changes in
     update(), each tick it is active. constant_A: A never changes, so the QP adds w A^T A
@@ -63,7 +63,7 @@ class Task:
 
 class AccelerationBounds(Protocol):
     """Bounds vdot_min <= vdot[v_indices] <= vdot_max that change with the state
-    (control/tasks.py: JointLimitBounds)."""
+    (control/tasks/: JointLimitBounds)."""
 
     v_indices: np.ndarray
 

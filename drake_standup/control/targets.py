@@ -1,6 +1,6 @@
 """What the tasks track: one mode's settings (StateReferences) and one tick's references
 (TaskReferences), made upstream of the QP (standup/task_references.py) and read by each
-task's update (control/tasks.py)."""
+task's update (control/tasks/)."""
 
 import math
 from dataclasses import dataclass, field

@@ -55,7 +55,7 @@ from drake_standup.world.sensing import (
 
 # Pad groups as metrics.json reports them (plural where there are two).
 _GROUP_LABELS = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
-# The pads under the seat pads of the contact schedule (control/schedule.py), in order.
+# The pads under the seat pads of the contact schedule (standup/contact_schedule.py), in order.
 SEAT_PAD_FRAMES = tuple(frame for frame, _ in SEAT_PAD_ROWS)
 
 
