@@ -20,6 +20,6 @@
                    contact commands -> torques; adding a task is adding an object to its
                    list (make_program), not editing the QP
 
-drake_standup/standup/standup_controller.py wires them with the state machine, the advancement
-and the CoM reference into the stand-up controller's diagram.
+standup/whole_body.py calls them once a tick, as one system beside the state machine, the
+advancement and the CoM reference (standup/standup_controller.py).
 """

@@ -5,7 +5,7 @@ control/model.py), the tick's task references (TaskReferences, control/targets.p
 the contact commands (ContactCommands, control/contacts.py), it solves one QP over
 [contact wrenches, vdot] with the task objects of control/tasks/ (control/qp.py) for
 the joint torques. The system that holds the torques and calls it once a tick is the
-stand-up's (standup/standup_controller.py); on a failed QP the last torques stay there.
+stand-up's (standup/whole_body.py); on a failed QP the last torques stay there.
 next_diagnostics packs a tick's DIAGNOSTICS.
 
 One QP program per set of active contacts (its size, and so its solve time, shrinks once
@@ -211,7 +211,7 @@ class ControllerTick:
 
 class WholeBodyController:
     """Momentum-based whole-body torque controller (module docstring): a plain object
-    whose solve() the stand-up controller's tick calls (standup/standup_controller.py)."""
+    whose solve() the stand-up controller's tick calls (standup/whole_body.py)."""
 
     def __init__(
         self,

@@ -94,7 +94,7 @@ def active_frames(specs: list[ContactSpec], active: tuple[bool, ...]) -> list[st
 
 class ControllerModel:
     """The controller's model at the robot's state, once a tick, and its weighing: a
-    plain object the stand-up controller's tick calls (standup/standup_controller.py).
+    plain object the stand-up controller's tick calls (standup/whole_body.py).
 
     The weighing is [estimate, began, model's scale] (control/mass.py: next_mass_state);
     its state lives in the calling system, from INITIAL_WEIGHING.

@@ -91,7 +91,7 @@ def phase_seat_hold(mode: StandupMode, table: PhaseTable) -> str:
 
 class ContactSchedule:
     """ContactCommands for the whole-body controller, once a tick: a plain object the
-    stand-up controller's tick calls (standup/standup_controller.py).
+    stand-up controller's tick calls (standup/whole_body.py).
 
     Its memory, kept by the caller (MEMORY_SIZE, zero at the start): [the loads the seat
     pads' release starts from (3), the controller's last successful commands to them

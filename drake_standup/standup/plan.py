@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from drake_standup.config import ControllerConfig, Scenario
-from drake_standup.config.phases import PHASES, SEAT_PADS, PhaseTable, resolve_com_heights
+from drake_standup.config.phases import PHASES, PhaseTable, resolve_com_heights
 from drake_standup.world.scene import erect_com_height_m
 from drake_standup.world.sensing import FeetReach
 from drake_standup.world.station import Station
@@ -25,8 +25,6 @@ class StandupPlan:
     table: PhaseTable
     # The rise's posture standing on this floor: the height a stand-up is judged at, m.
     erect_com_height_m: float
-    # The seat's pad groups, in the order every consumer keeps them (SEAT_PADS).
-    seat_pads: tuple[str, ...] = SEAT_PADS
 
     @property
     def n_states(self) -> int:
@@ -35,11 +33,8 @@ class StandupPlan:
 
     @property
     def states(self) -> tuple[int, ...]:
+        """1 to n_states: the modes the controller's tasks are active in."""
         return tuple(range(1, self.n_states + 1))
-
-    @property
-    def final_state(self) -> int:
-        return self.n_states
 
     @property
     def stance_states(self) -> set[int]:
