@@ -27,6 +27,7 @@ from drake_standup.cli import main
 from drake_standup.config import (
     JOINT_TABLES,
     ChairConfig,
+    InitialPose,
     PerturbationConfig,
     Push,
     RobotConfig,
@@ -515,9 +516,9 @@ def test_a_scenario_without_read_permission(tmp_path, capfd):
 
 
 def test_the_shipped_chair_and_a_copy_of_it_pass(tmp_path, monkeypatch):
-    """models/chair.sdf by its default name, a copy by its absolute path and by a path
+    """models/chair.sdf by its shipped name, a copy by its absolute path and by a path
     relative to the current folder: each validates, and names the file the scene loads."""
-    assert check_chair_file(Scenario().chair.file).resolve() == SHIPPED_CHAIR
+    assert check_chair_file("models/chair.sdf").resolve() == SHIPPED_CHAIR
     copy = tmp_path / "my_chair.sdf"
     copy.write_text(SHIPPED_CHAIR.read_text())
     scenario = apply_overrides(Scenario(), [("chair.file", str(copy))])
@@ -654,7 +655,7 @@ def test_every_joint_table_names_a_key():
     """Each JOINT_TABLES pattern vs the key paths of the default scenario: a pattern that
     names nothing (a typo, a renamed field) checks nothing; each names joints (a mapping
     or a list of names)."""
-    tables = _joint_tables(Scenario())
+    tables = _joint_tables(Scenario(initial=InitialPose(joints_rad={"l_knee": -1.7})))
     for pattern in JOINT_TABLES:
         regex = re.escape(pattern).replace(r"\[\*\]", r"\[\d+\]").replace(r"\*", r"[^.\[]*")
         assert any(re.fullmatch(regex, key) for key, _ in tables), pattern

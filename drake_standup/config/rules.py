@@ -15,6 +15,7 @@ import yaml
 from pydrake.common.yaml import yaml_dump_typed
 from pydrake.systems.analysis import GetIntegrationSchemes
 
+from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig
 from drake_standup.config.controller import QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
@@ -89,7 +90,8 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "controller.mass_scale_bounds compliance.virtual_mass_kg compliance.stiffness_N_per_m "
         "fall.max_com_horizontal_m perturbation.pushes[*].duration_s perturbation.*_scale "
         "perturbation.hand_wrench_noise_period_s plant.penetration_allowance "
-        "plant.stiction_tolerance simulator.accuracy",
+        "plant.stiction_tolerance simulator.accuracy chair.seat_height_m chair.cushion.* "
+        "chair.friction",
     ),
     (
         NON_NEGATIVE,
@@ -110,6 +112,12 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "simulator.start_time fall.min_root_height_m",
     ),
     (PLANT_STEP, "plant.time_step"),
+    # How far the hips sit behind the seat's edge, the feet stand in front of it: within
+    # a leg's length. m.
+    (
+        Range(low=-0.2, high=0.5),
+        "initial.hips_behind_seat_edge_m initial.feet_ahead_of_seat_edge_m",
+    ),
     (Range(low=1.0), "advancement.psi_dot_upper"),
     # Where the seat's release waits for the CoM, about the thigh pads: within a thigh's
     # length of them. m.
@@ -202,7 +210,8 @@ def validate(scenario: Scenario) -> Scenario:
     _check_rules(data)
     _check_across_fields(scenario)
     _check_names(scenario, data, check_robot_model(scenario.robot.model))
-    check_chair_file(scenario.chair.file)
+    if scenario.chair.file:
+        check_chair_file(scenario.chair.file)
     return scenario
 
 
@@ -255,6 +264,7 @@ def _check_across_fields(scenario: Scenario) -> None:
             f"controller_period_s: {period}; accepted: a whole multiple of plant.time_step "
             f"({step}), e.g. {step} or {2 * step}"
         )
+    _check_cushion(scenario.chair)
     for i, pull in enumerate(scenario.human.pulls):
         if 2 * pull.ramp_s > pull.duration_s:
             raise ScenarioError(
@@ -278,4 +288,17 @@ def _check_across_fields(scenario: Scenario) -> None:
         raise ScenarioError(
             f"human.reactive.lead_max_m: {reactive.lead_max_m}; accepted: a number >= "
             f"lead_min_m ({reactive.lead_min_m})"
+        )
+
+
+def _check_cushion(chair: ChairConfig) -> None:
+    """A cushion lies on the seat board (SEAT_BOARD_M), within the seat's height."""
+    if chair.cushion is None or chair.file:
+        return
+    room = chair.seat_height_m - SEAT_BOARD_M
+    if not chair.cushion.thickness_m < room:
+        raise ScenarioError(
+            f"chair.cushion.thickness_m: {chair.cushion.thickness_m:g}; accepted: a number "
+            f"in (0, {room:g}) m, under the seat's height ({chair.seat_height_m:g} m) less "
+            f"its board ({SEAT_BOARD_M:g} m)"
         )

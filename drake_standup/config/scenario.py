@@ -4,13 +4,12 @@ Defaults live here (and in config/controller.py) and nowhere else; the YAML file
 scenarios/ override what they name (config/loading.py).
 """
 
-import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
+from drake_standup.config.chair import ChairConfig, InitialPose, chair_file  # noqa: F401
 from drake_standup.config.controller import ControllerConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.config.resources import data_root
@@ -19,29 +18,6 @@ SCENARIO_DIR = data_root() / "scenarios"
 DEFAULT_SCENARIO = SCENARIO_DIR / "assisted.yaml"
 # Every actuator's effort limit: the paper's torque saturation (SPEC 3). N m.
 EFFORT_LIMIT_NM = 60.0
-
-
-def _seated_joints() -> dict[str, float]:
-    # SPEC section 3 (authors' seated pose), with the feasibility probe's knee
-    # (-1.7365 rad) and the ankle pitch that puts the soles flat on the floor
-    # for that knee (SPEC section 7: the window for feet on the floor is narrow).
-    legs = {
-        "hip_pitch": 1.5908,
-        "hip_roll": 0.2141,
-        "hip_yaw": 0.0,
-        "knee": -1.7365,
-        "ankle_pitch": -0.1452,
-        "ankle_roll": 0.0,
-    }
-    arms = {
-        "shoulder_pitch": -0.6981,
-        "shoulder_roll": 0.2094,
-        "shoulder_yaw": 1.3963,
-        "elbow": 0.5585,
-    }
-    joints = {f"{side}_{name}": q for side in "lr" for name, q in {**legs, **arms}.items()}
-    joints.update(torso_pitch=0.0, torso_roll=0.0, torso_yaw=0.0)
-    return joints
 
 
 # robot.reflected_inertia's settings (robot.reflects_motor_inertia).
@@ -69,27 +45,6 @@ class RobotConfig:
     # (SPEC 9: on for the real robots, off in Gazebo); the convergence study found it
     # cheaper per step and converged at a larger step (docs/performance.md).
     reflected_inertia: str = "real_robots"
-
-
-@dataclass
-class InitialPose:
-    """Seated pose: floating base and joint angles by joint name."""
-
-    # Base over the chair, height so that the sole pads touch the floor. m.
-    base_xyz_m: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.39])
-    # The iCub's root_link x axis points backwards: yaw pi faces the robot to +x.
-    base_rpy_rad: list[float] = field(default_factory=lambda: [0.0, 0.0, math.pi])
-    joints_rad: dict[str, float] = field(default_factory=_seated_joints)
-
-
-@dataclass
-class ChairConfig:
-    # The shipped models/chair.sdf (seat top at 0.2195 m, where the seated pads rest), or
-    # an SDF file of your own: absolute, or relative to the current directory.
-    file: str = "models/chair.sdf"
-    # Where the chair's model frame (floor, below the seat's front edge) stands.
-    # The front edge sits behind the knees (x ~ 0.22 m seated). m.
-    xyz_m: list[float] = field(default_factory=lambda: [0.16, 0.0, 0.0])
 
 
 @dataclass
@@ -420,10 +375,3 @@ class Scenario:
     visualization: VisualizationConfig = field(default_factory=VisualizationConfig)
     # Period of the signal loggers used by metrics and figures. s.
     log_period_s: float = 0.01
-
-
-def chair_file(name: str) -> Path:
-    """chair.file as a path: the user's own file (or folder: config.inputs names it), else a
-    shipped one such as models/chair.sdf, else the name as given (config.inputs: missing)."""
-    own, shipped = Path(name), data_root() / name
-    return shipped if not own.is_absolute() and not own.exists() and shipped.is_file() else own

@@ -81,7 +81,7 @@ class FallMonitor:
         )
         self._min_z = scenario.fall.min_root_height_m
         self._max_xy = scenario.fall.max_com_horizontal_m
-        self._xy0 = np.array(scenario.initial.base_xyz_m[:2])
+        self._xy0 = built.station.scene.seated.base.translation()[:2].copy()
         self._max_streak_s = scenario.fall.max_qp_failure_streak_s
         self._failing_since: float | None = None
         self.reason: str | None = None

@@ -18,7 +18,9 @@ from drake_standup.config.inputs import add_sdf
 from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
+from drake_standup.world.chair import chair_sdf
 from drake_standup.world.perturbations import scale_friction
+from drake_standup.world.seating import SeatedPose, seated_pose
 
 
 class _NoDeformableHalfSpaceWarning(logging.Filter):
@@ -37,6 +39,8 @@ class Scene:
     plant: MultibodyPlant
     scene_graph: SceneGraph
     robot: Robot
+    # The robot on its chair at t = 0 (world/seating.py).
+    seated: SeatedPose
 
 
 def add_scene(
@@ -62,8 +66,11 @@ def add_scene(
     )
     parser = Parser(plant)
     (floor,) = add_sdf(parser, model_file("floor.sdf"))
-    # One model with a frame 'chair' (config.validate parsed it so).
-    (chair,) = add_sdf(parser, chair_file(scenario.chair.file))
+    # One model with a frame 'chair' (config.validate parsed a user's file so).
+    if scenario.chair.file:
+        (chair,) = add_sdf(parser, chair_file(scenario.chair.file))
+    else:
+        (chair,) = parser.AddModelsFromString(chair_sdf(scenario.chair), "sdf")
     world = plant.world_frame()
     plant.WeldFrames(world, plant.GetFrameByName("floor", floor))
     plant.WeldFrames(
@@ -72,6 +79,7 @@ def add_scene(
         RigidTransform(scenario.chair.xyz_m),
     )
     plant.Finalize()
+    seated = seated_pose(plant, robot, scenario)
     # Model error of perturbation.friction_scale: every surface, in the model.
     scale_friction(plant, scene_graph, scenario.perturbation.friction_scale)
 
@@ -81,7 +89,7 @@ def add_scene(
     scene_graph.collision_filter_manager().Apply(
         CollisionFilterDeclaration().ExcludeWithin(robot_geometries)
     )
-    return Scene(plant, scene_graph, robot)
+    return Scene(plant, scene_graph, robot, seated)
 
 
 def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -> None:
@@ -89,14 +97,9 @@ def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -
     joints' names)."""
     plant = scene.plant
     instance = scene.robot.model_instance
-    init = scenario.initial
-    set_joint_positions(plant, plant_context, instance, init.joints_rad)
+    set_joint_positions(plant, plant_context, instance, scene.seated.joints_rad)
     root = plant.GetBodyByName("root_link", instance)
-    plant.SetFreeBodyPose(
-        plant_context,
-        root,
-        RigidTransform(RollPitchYaw(init.base_rpy_rad), init.base_xyz_m),
-    )
+    plant.SetFreeBodyPose(plant_context, root, scene.seated.base)
     plant.SetVelocities(plant_context, instance, 0.0 * plant.GetVelocities(plant_context, instance))
 
 
