@@ -12,6 +12,7 @@ MathematicalProgram on the plant's AutoDiff twin); every other joint keeps SEATE
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass
 
@@ -155,6 +156,9 @@ def _residuals(s: _Seating, geo: _Geometry, z) -> np.ndarray:
         front = pose.multiply(np.array([s.thigh_half, 0.0, 0.0]))
         # The pad's bottom where it leaves the seat (its front, or the seat's edge).
         share = (geo.edge - back[0]) / (front[0] - back[0])
+        if share <= 0.0:  # the pad wholly beyond the edge (perched): nothing to rest on
+            out += [share * 0 + 1.0] * 3
+            continue
         share = share if share < 1.0 else share * 0 + 1.0
         ends = [back[2] - geo.top, back[2] + share * (front[2] - back[2]) - geo.top]
         # Out of the seat, and resting on it (its lower end on the top).
@@ -164,9 +168,20 @@ def _residuals(s: _Seating, geo: _Geometry, z) -> np.ndarray:
 
 
 def _solve(s: _Seating, geo: _Geometry) -> np.ndarray | None:
-    """[hip pitch, knee, ankle, depth] of the seated pose, or None if there is none."""
+    """[hip pitch, knee, ankle, depth] of the seated pose, or None if there is none: on
+    the thighs as deep as it can, else (a high seat) perched, the thighs beyond the edge."""
+    sol = _solve_at(s, geo)
+    if sol is None and geo.depth[0] < geo.depth[1]:
+        perched = (0.0, s.thigh_front - 2 * s.thigh_half - SEAT_DEPTH_MARGIN_M)
+        sol = _solve_at(s, dataclasses.replace(geo, depth=perched), perched=True)
+    return sol
+
+
+def _solve_at(s: _Seating, geo: _Geometry, perched: bool = False) -> np.ndarray | None:
     prog = MathematicalProgram()
     z = prog.NewContinuousVariables(4, "z")
+    if perched:  # on a high seat: the thighs slope down from the hips, not up
+        prog.AddBoundingBoxConstraint(-np.inf, s.nominal[0], z[0])
     for k, (low, high) in enumerate(s.limits):
         prog.AddBoundingBoxConstraint(low + JOINT_MARGIN_RAD, high - JOINT_MARGIN_RAD, z[k])
     prog.AddBoundingBoxConstraint(geo.depth[0], geo.depth[1], z[3])
