@@ -290,7 +290,7 @@ def seat_height_range(model: str, hips_behind_seat_edge_m: float | None = None) 
             inside, outside = (middle, outside) if sits(middle) else (inside, middle)
         return inside
 
-    return (edge(nominal, 0.05), edge(nominal, 0.6))
+    return (float(edge(nominal, 0.05)), float(edge(nominal, 0.6)))
 
 
 def _robot_plant(model: str):
