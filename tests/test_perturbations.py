@@ -24,7 +24,8 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource, PassThrough
 
-from drake_standup.config import HumanConfig, InitialPose, Pull, Push, Scenario, ScenarioError
+from drake_standup.config import HumanConfig, Pull, Push, Scenario, ScenarioError
+from drake_standup.config.chair import SEATED_JOINTS
 from drake_standup.config.resources import model_file
 from drake_standup.robot.icub import ContactModel, add_icub
 from drake_standup.sim.diagram import build_diagram
@@ -219,7 +220,7 @@ def test_push_and_pull_change_momentum_by_their_impulse():
     )
     # The seated joint angles, inside the joint limits: the default (zero)
     # elbows are outside theirs and would snap in over the first steps.
-    seated = InitialPose().joints_rad
+    seated = SEATED_JOINTS
     for name in robot.joint_names:
         joint = plant.GetJointByName(name)
         lower, upper = joint.position_lower_limits()[0], joint.position_upper_limits()[0]

@@ -138,8 +138,10 @@ def _residuals(s: _Seating, geo: _Geometry, z) -> np.ndarray:
     plant.SetPositions(context, s.q(z[:3], base_x, base_z))
     soles = []
     for frame in s.soles:
-        pose = s.ad_frames[frame.name()].CalcPoseInWorld(context) if z.dtype == object else (
-            frame.CalcPoseInWorld(context)
+        pose = (
+            s.ad_frames[frame.name()].CalcPoseInWorld(context)
+            if z.dtype == object
+            else (frame.CalcPoseInWorld(context))
         )
         p, R = pose.translation(), pose.rotation().matrix()
         soles.append([p[2] - s.sole_z, R[0, 2], p[0]])
