@@ -71,7 +71,7 @@ def seated_state():
     scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
     plant, robot = scene.plant, scene.robot
     context = plant.CreateDefaultContext()
-    set_seated_state(scene, context, scenario)
+    set_seated_state(scene, context)
     x = plant.GetPositionsAndVelocities(context, robot.model_instance)
     specs = contact_specs(plant, robot, ControllerConfig())
     kinematics = RobotKinematics(

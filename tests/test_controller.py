@@ -44,7 +44,7 @@ def scene():
     builder = DiagramBuilder()
     scene = add_scene(builder, scenario, pd_gains=None, visuals=False)
     context = scene.plant.CreateDefaultContext()
-    set_seated_state(scene, context, scenario)
+    set_seated_state(scene, context)
     x0 = scene.plant.GetPositionsAndVelocities(context, scene.robot.model_instance)
     return scene, x0
 

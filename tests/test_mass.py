@@ -57,7 +57,7 @@ def test_the_controllers_model_weighs_the_seated_robot():
     config = ControllerConfig()
     model = ControllerModel(plant, robot, contact_specs(plant, robot, config), config, 0.004)
     plant_context = plant.CreateDefaultContext()
-    set_seated_state(scene, plant_context, scenario)
+    set_seated_state(scene, plant_context)
     m = plant.CalcTotalMass(plant_context, [robot.model_instance])
     g = -plant.gravity_field().gravity_vector()[2]
     hands = np.zeros(12)

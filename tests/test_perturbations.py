@@ -386,7 +386,7 @@ def test_mass_scale_acts_on_the_simulated_plant_only():
     root = built.diagram.CreateDefaultContext()
     root.SetTime(1.0)
     plant_context = plant.GetMyMutableContextFromRoot(root)
-    set_seated_state(built.station.scene, plant_context, scenario)
+    set_seated_state(built.station.scene, plant_context)
     nominal_context = plant.CreateDefaultContext()
     nominal = plant.CalcTotalMass(nominal_context, [instance])
     apply_model_errors(built.station.scene, plant_context, scenario)

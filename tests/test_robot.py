@@ -114,7 +114,7 @@ def seated(isolated_cache):
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     plant_context = scene.plant.GetMyContextFromRoot(context)
-    set_seated_state(scene, plant_context, scenario)
+    set_seated_state(scene, plant_context)
     return scene, plant_context, scenario, diagram
 
 

@@ -41,7 +41,7 @@ def rig():
     scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
     plant, robot = scene.plant, scene.robot
     context = plant.CreateDefaultContext()
-    set_seated_state(scene, context, scenario)
+    set_seated_state(scene, context)
     specs = contact_specs(plant, robot, ControllerConfig())
     kinematics = RobotKinematics(
         plant, robot, held_frames=[], other_frames=[s.frame for s in specs] + list(HANDS)

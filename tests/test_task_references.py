@@ -40,7 +40,7 @@ def rig():
     scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
     plant, robot = scene.plant, scene.robot
     context = plant.CreateDefaultContext()
-    set_seated_state(scene, context, scenario)
+    set_seated_state(scene, context)
     instance = robot.model_instance
     rng = np.random.default_rng(4)
     plant.SetVelocities(context, instance, rng.normal(scale=0.2, size=plant.num_velocities()))

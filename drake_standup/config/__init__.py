@@ -10,6 +10,7 @@ inputs.py      the files, folders and robot names a user gives (read_text_file, 
 errors.py      ScenarioError: one line naming the key or file
 """
 
+from drake_standup.config.chair import ChairConfig, InitialPose, chair_file
 from drake_standup.config.controller import QP_SOLVERS, ControllerConfig
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import check_output_dir, read_text_file
@@ -26,11 +27,9 @@ from drake_standup.config.scenario import (
     RESPONSES,
     SCENARIO_DIR,
     AdvancementConfig,
-    ChairConfig,
     ComplianceConfig,
     FallConfig,
     HumanConfig,
-    InitialPose,
     PerturbationConfig,
     Pull,
     Push,
@@ -40,7 +39,6 @@ from drake_standup.config.scenario import (
     SeatHoldConfig,
     StandupConfig,
     VisualizationConfig,
-    chair_file,
 )
 
 __all__ = [

@@ -22,9 +22,9 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import DiagramBuilder
 
+from drake_standup.config.chair import chair_file
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.resources import model_file
-from drake_standup.config.scenario import chair_file
 
 # --- Files and folders -------------------------------------------------------------------
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
-from drake_standup.config.chair import ChairConfig, InitialPose, chair_file  # noqa: F401
+from drake_standup.config.chair import ChairConfig, InitialPose
 from drake_standup.config.controller import ControllerConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.config.resources import data_root

@@ -261,7 +261,7 @@ def add_seat_hold(builder, scene: Scene, scenario: Scenario, desired_state, actu
     plant = scene.plant
     instance = scene.robot.model_instance
     plant_context = plant.CreateDefaultContext()
-    set_seated_state(scene, plant_context, scenario)
+    set_seated_state(scene, plant_context)
     q0 = plant.GetPositions(plant_context, instance)
     u_ff = plant.MakeActuationMatrix().T @ (-plant.CalcGravityGeneralizedForces(plant_context))
     q_index = actuated_joints(plant, instance).q_index

@@ -163,7 +163,7 @@ def prepare(
     ApplySimulatorConfig(scenario.simulator, simulator)
     station = built.station
     plant_context = station.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
-    set_seated_state(station.scene, plant_context, scenario)
+    set_seated_state(station.scene, plant_context)
     apply_model_errors(station.scene, plant_context, scenario)
     fall = FallMonitor(built, scenario)
     simulator.set_monitor(fall)

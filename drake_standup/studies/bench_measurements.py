@@ -111,7 +111,7 @@ def time_plant_step(scenario: Scenario, steps: int) -> dict:
     simulator = Simulator(builder.Build())
     ApplySimulatorConfig(scenario.simulator, simulator)
     set_seated_state(
-        scene, scene.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()), scenario
+        scene, scene.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
     )
     plant_only = _step_times_s(simulator, step_s, steps)
 
@@ -120,9 +120,7 @@ def time_plant_step(scenario: Scenario, steps: int) -> dict:
     ApplySimulatorConfig(scenario.simulator, simulator)
     station = built.station
     set_seated_state(
-        station.scene,
-        station.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context()),
-        scenario,
+        station.scene, station.plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
     )
     diagram = _step_times_s(simulator, step_s, steps)
     return {

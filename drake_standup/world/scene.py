@@ -92,9 +92,8 @@ def add_scene(
     return Scene(plant, scene_graph, robot, seated)
 
 
-def set_seated_state(scene: Scene, plant_context: Context, scenario: Scenario) -> None:
-    """Puts the robot in the scenario's seated pose, at rest (config.validate checked the
-    joints' names)."""
+def set_seated_state(scene: Scene, plant_context: Context) -> None:
+    """Puts the robot in the scene's seated pose (scene.seated), at rest."""
     plant = scene.plant
     instance = scene.robot.model_instance
     set_joint_positions(plant, plant_context, instance, scene.seated.joints_rad)
@@ -110,7 +109,7 @@ def _standing_context(scene: Scene, scenario: Scenario, posture_rad: dict[str, f
     plant = scene.plant
     instance = scene.robot.model_instance
     context = plant.CreateDefaultContext()
-    set_seated_state(scene, context, scenario)
+    set_seated_state(scene, context)
     soles = [scene.robot.frame(plant, name) for name in ("l_sole", "r_sole")]
     sole_z_seated = [frame.CalcPoseInWorld(context).translation()[2] for frame in soles]
     set_joint_positions(plant, context, instance, posture_rad)
