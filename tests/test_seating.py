@@ -129,8 +129,12 @@ def test_the_range_holds_and_ends():
             "chair.cushion.thickness_m: 0.2; accepted: a number in (0, 0.1795) m",
         ),
         ("initial.feet_ahead_of_seat_edge_m=0.45", "cannot sit on this chair with its soles"),
+        (
+            "initial.hips_behind_seat_edge_m=0.45",
+            "initial.hips_behind_seat_edge_m: 0.45; accepted: a number in [-0.014, 0.316] m",
+        ),
     ],
-    ids=["seat_too_high", "cushion_thicker_than_seat", "feet_out_of_reach"],
+    ids=["seat_too_high", "cushion_thicker_than_seat", "feet_out_of_reach", "hips_off_seat"],
 )
 def test_a_chair_it_cannot_sit_on_is_one_error_line(tmp_path, setting, message):
     """run_diagram.py: one `error:` line naming the key and what is accepted, exit 2."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +25,7 @@ from pydrake.solvers import MathematicalProgram, Solve
 from drake_standup.config import Scenario, ScenarioError
 from drake_standup.config.chair import SEATED_BASE_XYZ_M, SEATED_JOINTS, ChairConfig, InitialPose
 from drake_standup.robot.icub import add_icub
+from drake_standup.world.chair import SEAT_DEPTH_M
 
 # The solved joints: both sides alike (the seated pose is symmetric).
 LEG_JOINTS = ("hip_pitch", "knee", "ankle_pitch")
@@ -64,7 +66,7 @@ class _Geometry:
 
 def _pad_bottom_m(robot, group: str) -> float:
     """How far below its frame a pad group's box reaches (models/icub_contact.yaml)."""
-    (shape,) = [s for s in robot.contact_shapes if s.group == group][:1]
+    shape = next(s for s in robot.contact_shapes if s.group == group)
     return -(shape.xyz_m[2] - shape.size_m[2] / 2)
 
 
@@ -100,19 +102,26 @@ class _Seating:
         self.soles = [frame(plant, n) for n in ("l_sole", "r_sole")]
         self.thighs = [frame(plant, n) for n in ("l_thigh", "r_thigh")]
         self.sole_z = _pad_bottom_m(robot, "sole")
-        thigh = [s for s in robot.contact_shapes if s.group == "thigh"][0]
+        thigh = next(s for s in robot.contact_shapes if s.group == "thigh")
         self.thigh_half = thigh.size_m[0] / 2
         buttocks = frame(plant, "buttocks")
         self.buttocks_below_base = -buttocks.CalcPoseInWorld(self.context).translation()[2]
         hip = plant.GetJointByName("l_hip_pitch", self.instance).frame_on_parent()
         self.hip_x = hip.CalcPoseInWorld(self.context).translation()[0]
         self.thigh_front = self._thigh_front_ahead_of_hip()
-        self.ad = plant.ToAutoDiffXd()
-        self.ad_context = self.ad.CreateDefaultContext()
-        self.ad_frames = {
-            f.name(): self.ad.GetFrameByName(f.name(), self.instance)
-            for f in (*self.soles, *self.thighs)
-        }
+        # The buttocks pad's front and back ends behind the hip axes. m.
+        pad = next(c for c in robot.contact_shapes if c.group == "buttocks")
+        ends = buttocks.CalcPoseInWorld(self.context)
+        xs = [ends.multiply([x * pad.size_m[0] / 2, 0, 0])[0] for x in (-1, 1)]
+        self.buttocks_span = (self.hip_x - max(xs), self.hip_x - min(xs))
+
+    @functools.cached_property
+    def autodiff(self):
+        """The plant's AutoDiff twin, its context and its sole and thigh frames (built only
+        when a pose is solved: a given pose needs none)."""
+        ad = self.plant.ToAutoDiffXd()
+        frames = [ad.GetFrameByName(f.name(), self.instance) for f in (*self.soles, *self.thighs)]
+        return ad, ad.CreateDefaultContext(), frames[:2], frames[2:]
 
     def _thigh_front_ahead_of_hip(self) -> float:
         """The thigh pads' front end ahead of the hip axes in SEATED_JOINTS. m."""
@@ -134,26 +143,21 @@ def _residuals(s: _Seating, geo: _Geometry, z) -> np.ndarray:
     lowest point over the seat above its top, for z = [hip pitch, knee, ankle, depth]."""
     base_x = geo.edge - z[3] - s.hip_x
     base_z = geo.top + s.buttocks_below_base
-    plant, context = (s.ad, s.ad_context) if z.dtype == object else (s.plant, s.context)
+    if z.dtype == object:
+        plant, context, soles, thighs = s.autodiff
+    else:
+        plant, context, soles, thighs = s.plant, s.context, s.soles, s.thighs
     plant.SetPositions(context, s.q(z[:3], base_x, base_z))
-    soles = []
-    for frame in s.soles:
-        pose = (
-            s.ad_frames[frame.name()].CalcPoseInWorld(context)
-            if z.dtype == object
-            else (frame.CalcPoseInWorld(context))
-        )
+    sole_rows = []
+    for frame in soles:
+        pose = frame.CalcPoseInWorld(context)
         p, R = pose.translation(), pose.rotation().matrix()
-        soles.append([p[2] - s.sole_z, R[0, 2], p[0]])
+        sole_rows.append([p[2] - s.sole_z, R[0, 2], p[0]])
     # Both soles, on average: the model's two legs differ by 0.1 mm.
-    z_sole, pitch, x_sole = [(a + b) / 2 for a, b in zip(*soles, strict=True)]
+    z_sole, pitch, x_sole = [(a + b) / 2 for a, b in zip(*sole_rows, strict=True)]
     out = [z_sole, pitch] + ([] if geo.feet is None else [x_sole - geo.feet])
-    for frame in s.thighs:
-        pose = (
-            s.ad_frames[frame.name()].CalcPoseInWorld(context)
-            if z.dtype == object
-            else (frame.CalcPoseInWorld(context))
-        )
+    for frame in thighs:
+        pose = frame.CalcPoseInWorld(context)
         back = pose.multiply(np.array([-s.thigh_half, 0.0, 0.0]))
         front = pose.multiply(np.array([s.thigh_half, 0.0, 0.0]))
         # The pad's bottom where it leaves the seat (its front, or the seat's edge).
@@ -215,6 +219,21 @@ def _geometry(s: _Seating, chair: ChairConfig, init: InitialPose) -> _Geometry:
     return _Geometry(chair.seat_top_z_m(), edge, depth, None if feet is None else edge + feet)
 
 
+def _check_depth(s: _Seating, chair: ChairConfig, depth: float | None) -> None:
+    """A given depth keeps the buttocks pad wholly on the seat (on a chair of one's own
+    file, whose depth the program does not know, in front of its back only loosely)."""
+    if depth is None:
+        return
+    low = -s.buttocks_span[0]
+    high = SEAT_DEPTH_M - s.buttocks_span[1] if not chair.file else math.inf
+    if not low <= depth <= high:
+        raise ScenarioError(
+            f"initial.hips_behind_seat_edge_m: {depth:g}; accepted: a number in "
+            f"[{low:.3f}, {high:.3f}] m, the buttocks pad wholly on the "
+            f"{SEAT_DEPTH_M:g} m deep seat, or null (as deep as the seat allows)"
+        )
+
+
 def seated_pose(plant: MultibodyPlant, robot, scenario: Scenario) -> SeatedPose:
     """The scenario's seated pose on plant (finalized, with its chair): as given
     (initial.joints_rad), else solved. Raises ScenarioError (one line) if the robot cannot
@@ -222,43 +241,45 @@ def seated_pose(plant: MultibodyPlant, robot, scenario: Scenario) -> SeatedPose:
     init, chair = scenario.initial, scenario.chair
     s = _Seating(plant, robot, init)
     if init.joints_rad is not None:
+        joints = {**s.joints, **init.joints_rad}
         base = init.base_xyz_m or SEATED_BASE_XYZ_M
-        return _given(s, chair, init, base)
+        return _placed_pose(s, base, joints, chair.seat_edge_x_m())
+    _check_depth(s, chair, init.hips_behind_seat_edge_m)
     geo = _geometry(s, chair, init)
     sol = _solve(s, geo)
     if sol is None:
-        raise ScenarioError(_cannot_sit(scenario, geo))
+        raise ScenarioError(_cannot_sit(scenario))
     joints = dict(s.joints)
     for k, joint in enumerate(LEG_JOINTS):
         joints[f"l_{joint}"] = joints[f"r_{joint}"] = float(sol[k])
     base_xyz = [geo.edge - sol[3] - s.hip_x, 0.0, geo.top + s.buttocks_below_base]
-    if init.base_xyz_m is not None:
-        base_xyz = list(init.base_xyz_m)
-    pose = SeatedPose(RigidTransform(s.rotation, base_xyz), joints, float(sol[3]), 0.0)
-    return _with_feet(s, pose, geo.edge)
+    return _placed_pose(s, init.base_xyz_m or base_xyz, joints, geo.edge)
 
 
-def _given(s: _Seating, chair: ChairConfig, init: InitialPose, base) -> SeatedPose:
-    joints = {**s.joints, **init.joints_rad}
-    pose = SeatedPose(RigidTransform(s.rotation, base), joints, 0.0, 0.0)
-    return _with_feet(s, pose, chair.seat_edge_x_m())
-
-
-def _with_feet(s: _Seating, pose: SeatedPose, edge: float) -> SeatedPose:
-    """pose with its hips' and feet's places measured about the seat's edge."""
+def _placed_pose(s: _Seating, base_xyz, joints: dict[str, float], edge: float) -> SeatedPose:
+    """The pose of base_xyz and joints, its hips' and feet's places measured about the
+    seat's edge."""
+    base = RigidTransform(s.rotation, list(base_xyz))
     plant, context = s.plant, s.plant.CreateDefaultContext()
-    plant.SetFreeBodyPose(context, s.root, pose.base)
-    for name, value in pose.joints_rad.items():
+    plant.SetFreeBodyPose(context, s.root, base)
+    for name, value in joints.items():
         plant.GetJointByName(name, s.instance).set_angle(context, value)
     hip = plant.GetJointByName("l_hip_pitch", s.instance).frame_on_parent()
     hip_x = hip.CalcPoseInWorld(context).translation()[0]
     feet_x = np.mean([f.CalcPoseInWorld(context).translation()[0] for f in s.soles])
-    return SeatedPose(pose.base, pose.joints_rad, edge - hip_x, float(feet_x - edge))
+    return SeatedPose(base, joints, float(edge - hip_x), float(feet_x - edge))
 
 
-def _cannot_sit(scenario: Scenario, geo: _Geometry) -> str:
-    low, high = seat_height_range(scenario.robot.model, scenario.initial.hips_behind_seat_edge_m)
+def _cannot_sit(scenario: Scenario) -> str:
+    depth = scenario.initial.hips_behind_seat_edge_m
+    low, high = seat_height_range(scenario.robot.model, depth)
     chair = scenario.chair
+    if np.isnan(low):
+        return (
+            f"initial.hips_behind_seat_edge_m: {depth:g}; the {scenario.robot.model} cannot "
+            "sit that far behind the seat's edge with its soles flat on the floor; accepted: "
+            "null (as deep as the seat allows) or a depth it sits at on the shipped seat"
+        )
     return (
         f"chair.seat_height_m: {chair.seat_height_m:g}; the {scenario.robot.model} cannot sit "
         f"on this chair with its soles flat on the floor"
