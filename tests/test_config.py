@@ -210,13 +210,14 @@ def _every_key(scenario: Scenario) -> list[tuple[str, object]]:
 
 def _full_scenario() -> Scenario:
     """The assisted scenario with one of everything: a pull, a push, a torque limit, an
-    absolute end height, a cushion and the robot's place on the seat."""
+    absolute end height and x, a cushion and the robot's place on the seat."""
     return apply_overrides(
         load_scenario("assisted"),
         [
             ("perturbation.pushes", [{"body": "chest"}]),
             ("controller.torque_limit_Nm", 50.0),
             ("phases.rise.com_height_m", 0.575),
+            ("phases.lift_off.com_x_m", 0.23),
             ("chair.cushion", {"modulus_Pa": 1e5}),
             ("initial.hips_behind_seat_edge_m", 0.16),
             ("initial.feet_ahead_of_seat_edge_m", 0.04),

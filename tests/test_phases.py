@@ -64,11 +64,13 @@ def test_the_defaults_are_the_sources_numbers():
 def test_an_older_file_gives_the_default_table():
     """Every older key at the value it had by default: the same table as no key at all,
     but for the standing height, which the older key sets absolute (0.575 m, where the
-    default is now each model's erect height); the keys are gone from the loaded
-    scenario (its scenario.yaml spells the table)."""
+    default is now each model's erect height), and the forward displacement, which the
+    older key measures from the seated CoM (the default now from the soles); the keys are
+    gone from the loaded scenario (its scenario.yaml spells the table)."""
     older = parse_scenario(OLDER)
     expected = Scenario().phases
     expected.rise.com_height_m = 0.575
+    expected.forward.com_x_over_soles_m = None
     assert older.phases == expected
     assert not hasattr(older.standup, "segment_psi")
     assert not hasattr(older.controller, "lean_states")

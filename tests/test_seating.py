@@ -148,3 +148,24 @@ def test_a_chair_it_cannot_sit_on_is_one_error_line(tmp_path, setting, message):
     assert done.returncode == 2, done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ") and message in lines[0], lines
+
+
+@pytest.mark.parametrize("height", [0.18, 0.2195, 0.25])
+def test_the_forward_target_follows_the_feet(height):
+    """The plan ends state 2's CoM segment where the table says about the seated soles
+    (the soles' frames by forward kinematics), on every seat; on the shipped one that is
+    SPEC 3's 0.1277 m in front of where the CoM sits, to 0.5 mm."""
+    from drake_standup.standup.plan import feet_reach, make_plan
+    from drake_standup.world.station import make_station
+
+    scenario = apply_overrides(load_scenario("assisted"), [("chair.seat_height_m", height)])
+    station = make_station(scenario, feet_reach(scenario.controller))
+    plan = make_plan(scenario, station)
+    plant, context = _posed(station.scene)
+    soles = [station.scene.robot.frame(plant, f"{s}_sole") for s in "lr"]
+    soles_x = np.mean([f.CalcPoseInWorld(context).translation()[0] for f in soles])
+    forward = plan.table.forward
+    assert forward.com_x_m == pytest.approx(soles_x + forward.com_x_over_soles_m, abs=1e-9)
+    if height == 0.2195:
+        com = plant.CalcCenterOfMassPositionInWorld(context, [station.scene.robot.model_instance])
+        assert forward.com_x_m - com[0] == pytest.approx(0.1277, abs=5e-4)

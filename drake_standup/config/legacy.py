@@ -32,7 +32,11 @@ _LEGACY: dict[str, tuple[object, _Writes]] = {
             | {3: {"segment_psi": v[1]}, 4: {"segment_psi": v[2]}}
         ),
     ),
-    "standup.state2_com_delta_m": (3, lambda v: {2: {"com_delta_m": v}}),
+    # An older file's forward displacement is from where the CoM sits, whatever the seat.
+    "standup.state2_com_delta_m": (
+        3,
+        lambda v: {2: {"com_delta_m": v, "com_x_over_soles_m": None}},
+    ),
     "standup.state3_com_delta_m": (3, lambda v: {3: {"com_delta_m": v}}),
     "standup.standing_com_height_m": ("number", lambda v: {4: {"com_height_m": v}}),
     "standup.feet_force_2to3_N": ("number", lambda v: {2: {"exit.feet_force_N": v}}),

@@ -91,6 +91,11 @@ class Phase:
     # seat after a sit-back (the phase itself holds the CoM where it sits).
     segment_psi: float = 1.0
     com_delta_m: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    # An absolute end x (replacing the displacement's x), or one this far in front of the
+    # soles' frames (under the ankles) where the robot sits, which the plan makes absolute
+    # (standup/plan.py): the feet's place, not the chair's, says how far forward. m.
+    com_x_m: float | None = None
+    com_x_over_soles_m: float | None = None
     com_height_m: float | None = None
     # Without com_height_m: end at the erect CoM height of this phase's posture on the
     # scenario's robot (scene.erect_com_height_m, resolved by resolve_com_heights), so
@@ -143,11 +148,13 @@ class PhaseTable:
     )
     # 2: the CoM forward over the feet (SPEC 3: [0.1277, -0.0295, 0]; the lateral part
     # belonged to the authors' asymmetric posture, ours is symmetric), the pelvis pitched
-    # forward; the buttocks lift off the seat.
+    # forward; the buttocks lift off the seat. SPEC 3's 0.1277 m, measured from the
+    # shipped seated pose, ends 8.1 mm behind the soles' frames: kept there on any seat.
     forward: Phase = field(
         default_factory=lambda: Phase(
             segment_psi=1.5,
             com_delta_m=[0.1277, 0.0, 0.0],
+            com_x_over_soles_m=-0.0081,
             posture_rad=posture(
                 [1.5402, 0.1594, -1.7365, -0.2814, -1.6455, 0.4363, 0.5862, 0.2473, 1.0]
             ),
@@ -220,6 +227,16 @@ class PhaseTable:
             if pads in phase.unload:
                 return state
         return None
+
+
+def resolve_com_x(table: PhaseTable, soles_x_m: float) -> PhaseTable:
+    """A copy of table whose com_x_over_soles_m phases without a com_x_m end that far in
+    front of soles_x_m (the soles' frames' x where the robot sits, m)."""
+    resolved = copy.deepcopy(table)
+    for phase in resolved:
+        if phase.com_x_over_soles_m is not None and phase.com_x_m is None:
+            phase.com_x_m = soles_x_m + phase.com_x_over_soles_m
+    return resolved
 
 
 def resolve_com_heights(table: PhaseTable, erect_height_m) -> PhaseTable:

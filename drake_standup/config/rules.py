@@ -121,7 +121,9 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (Range(low=1.0), "advancement.psi_dot_upper"),
     # Where the seat's release waits for the CoM, about the thigh pads: within a thigh's
     # length of them. m.
-    (Range(low=-0.3, high=0.3), "phases.*.unload_when"),
+    (Range(low=-0.3, high=0.3), "phases.*.unload_when phases.*.com_x_over_soles_m"),
+    # An absolute end x of the CoM: within a metre of the world's origin (the chair's). m.
+    (Range(low=-1.0, high=1.0), "phases.*.com_x_m"),
     (Range(high=1.0, high_open=True), "advancement.taper_from_progress"),
     (Range(high=1.0, high_open=True), "controller.stance_from_progress"),
     (

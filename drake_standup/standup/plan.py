@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from drake_standup.config import ControllerConfig, Scenario
-from drake_standup.config.phases import PHASES, PhaseTable, resolve_com_heights
+from drake_standup.config.phases import PHASES, PhaseTable, resolve_com_heights, resolve_com_x
 from drake_standup.world.scene import erect_com_height_m
 from drake_standup.world.sensing import FeetReach
 from drake_standup.world.station import Station
@@ -57,9 +57,10 @@ def _posture_key(posture_rad: dict[str, float]) -> tuple:
 
 
 def make_plan(scenario: Scenario, station: Station) -> StandupPlan:
-    """The plan for scenario's robot in the station's scene: each standing posture's CoM
-    height from forward kinematics (scene.erect_com_height_m), once per distinct posture;
-    the rise's is the station's own where it stands erect (its standing support)."""
+    """The plan for scenario's robot in the station's scene: the forward ends from where the
+    soles are seated (resolve_com_x); each standing posture's CoM height from forward
+    kinematics (scene.erect_com_height_m), once per distinct posture; the rise's is the
+    station's own where it stands erect (its standing support)."""
     rise = scenario.phases.rise
     heights: dict[tuple, float] = {}
     if rise.com_height_m is None:
@@ -71,5 +72,7 @@ def make_plan(scenario: Scenario, station: Station) -> StandupPlan:
             heights[key] = erect_com_height_m(station.scene, scenario, posture_rad)
         return heights[key]
 
-    table = resolve_com_heights(scenario.phases, erect)
+    seated = station.scene.seated
+    soles_x = scenario.chair.seat_edge_x_m() + seated.feet_ahead_of_seat_edge_m
+    table = resolve_com_heights(resolve_com_x(scenario.phases, soles_x), erect)
     return StandupPlan(table, erect(scenario.phases.rise.posture_rad))

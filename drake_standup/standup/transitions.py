@@ -351,12 +351,15 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
     """state's phase entered: its segment starts where the previous one ended (that one
     is done, or holds still), at the CoM's height where the phase says so (bumpless: a
     stiffer height gain would otherwise see the lean's 1-3 cm drop as a step), toward its
-    displacement, its absolute height, or where a step back left it to end."""
+    displacement (its absolute x and height where given), or where a step back left it
+    to end."""
     phase = table.phase(state)
     x_start = mode.segment_end()
     if phase.start_at_com_height:
         x_start[2] = float(m.com_W[2])
     delta = np.array(phase.com_delta_m, dtype=float)
+    if phase.com_x_m is not None:
+        delta[0] = phase.com_x_m - x_start[0]
     if phase.com_height_m is not None:
         delta[2] = phase.com_height_m - x_start[2]
     if mode.stepped_back():
