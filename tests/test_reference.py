@@ -11,7 +11,8 @@ from drake_standup.config.phases import PhaseTable, resolve_com_heights
 from drake_standup.standup.com_path import CoMReferenceGenerator, min_jerk, path
 from drake_standup.standup.transitions import Measurements, initial_mode, next_mode
 
-SEGMENT = np.array([0.7, 1.5, 0.06, 0.0, 0.38, 0.1277, -0.01, 0.03])  # psi_e, T, x0, delta
+# psi_e, T, x0, delta, height_follows (off: the path's height)
+SEGMENT = np.array([0.7, 1.5, 0.06, 0.0, 0.38, 0.1277, -0.01, 0.03, 0.0])
 
 
 def test_min_jerk_profile_boundary_values():
@@ -34,6 +35,7 @@ def _reference(psi, psi_dot, psi_ddot, segment=SEGMENT):
     system.GetInputPort("psi_dot").FixValue(context, [psi_dot])
     system.GetInputPort("psi_ddot").FixValue(context, [psi_ddot])
     system.GetInputPort("segment").FixValue(context, segment)
+    system.GetInputPort("com_W").FixValue(context, [0.5, 0.2, 0.1])  # unread: not following
     out = system.GetOutputPort("com_reference").Eval(context)
     tangent = system.GetOutputPort("path_tangent_W").Eval(context)
     return out[:3], out[3:6], out[6:], tangent

@@ -102,6 +102,13 @@ class Phase:
     # that each model stands at its own height.
     com_height_erect: bool = False
     start_at_com_height: bool = False
+    # The reference's height is the measured CoM's all through the phase (its rate and
+    # acceleration 0: the z gain only damps the vertical motion), not the segment's: a
+    # phase that moves the CoM forward and lets its height go where the posture takes
+    # it (the pelvis' pitch dips the CoM ~5 cm in `forward`). The next segment starts at
+    # that height, where the reference is: no jump (com_path.py). Phases 2-4 (the
+    # seated phase and a sit-back's return hold the segment's height).
+    com_height_follows: bool = False
     # CoM stiffness K_P (x, y, z); K_D = 2 zeta sqrt(K_P) (controller.com_damping_ratio).
     # 1/s^2.
     com_kp_per_s2: list[float] = field(default_factory=lambda: [60.0, 40.0, 5.0])
