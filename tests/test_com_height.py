@@ -197,3 +197,25 @@ def test_a_step_back_holds_the_reference_used():
     assert held.state == 2 and not held.height_follows
     np.testing.assert_allclose(_used(held, psi, com), before, atol=1e-12)
     np.testing.assert_allclose(_used(held, psi + 1.0, com - [0.0, 0.0, 0.01]), before, atol=1e-12)
+
+
+def test_entered_again_after_a_step_back_it_starts_where_the_hold_was():
+    """Once the pull has stopped, state 3 starts again from the held reference, not from
+    the CoM's height (which sank meanwhile under state 2's gains): no jump."""
+    table = _table()
+    mode = _in_state_2(table)
+    mode = _enter(mode, 3, _m(5.0, 5.0, [0.2, 0.0, 0.33]), table)
+    t = psi = 5.0 + 0.5 * table.lift_off.unload_s
+    back = (-10.0, -10.0)
+    m = _m(t, psi, [0.21, 0.0, 0.325], hands=back)
+    held = next_mode(_settled(mode, m, table), m, CFG, table)
+    assert held.state == 2
+    x_held = _used(held, psi, m.com_W)
+    held = dataclasses.replace(held, hindered_until_s=t + 1.0)
+    go = t + 1.0 + CFG.resume_after_s + 0.01
+    sunk = np.array([0.21, 0.0, 0.314])  # 11 mm lower
+    m = _m(go, go, sunk)
+    again = next_mode(_settled(held, m, table), m, CFG, table)
+    assert again.state == 3
+    np.testing.assert_allclose(_used(again, go, sunk), x_held, atol=1e-12)
+    assert abs(x_held[2] - sunk[2]) > 0.01

@@ -374,10 +374,13 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
     followed the CoM (that is where the reference is) or where the phase says so
     (bumpless: a stiffer height gain would otherwise see the lean's 1-3 cm drop as a
     step), toward its displacement (its absolute x and height where given), or where a
-    step back left it to end; its height follows the CoM where the phase says so."""
+    step back left it to end; its height follows the CoM where the phase says so. Entered
+    again after a step back, it starts where the step back held the reference, at any
+    height: from the CoM's it jumped by the height the CoM lost meanwhile (11 mm in one
+    10 ms sample, measured)."""
     phase = table.phase(state)
     x_start = mode.segment_end()
-    if mode.height_follows or phase.start_at_com_height:
+    if mode.height_follows or (phase.start_at_com_height and not mode.stepped_back()):
         x_start[2] = float(m.com_W[2])
     delta = np.array(phase.com_delta_m, dtype=float)
     if phase.com_x_m is not None:
