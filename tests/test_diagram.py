@@ -60,6 +60,7 @@ def test_signals_flow_from_the_human_through_the_station_to_the_controller(built
     assert source_of(brain, "advancement", "com_W") == ("sensing", "com_W")
     assert source_of(brain, "com_reference", "psi") == ("advancement", "psi")
     assert source_of(brain, "com_reference", "segment") == ("state_machine", "segment")
+    assert source_of(brain, "com_reference", "com_W") == ("sensing", "com_W")
     assert source_of(brain, "controller", "mode") == ("state_machine", "mode")
     assert source_of(brain, "controller", "com_reference") == ("com_reference", "com_reference")
     assert source_of(brain, "controller", "robot_state") == ("plant", "iCub_state")

@@ -8,10 +8,11 @@ import pytest
 
 from drake_standup.config import StandupConfig
 from drake_standup.config.phases import PhaseTable, resolve_com_heights
-from drake_standup.standup.com_path import CoMReferenceGenerator, min_jerk, path
+from drake_standup.standup.com_path import CoMReferenceGenerator, min_jerk, path, reference_at
 from drake_standup.standup.transitions import Measurements, initial_mode, next_mode
 
-SEGMENT = np.array([0.7, 1.5, 0.06, 0.0, 0.38, 0.1277, -0.01, 0.03])  # psi_e, T, x0, delta
+# psi_e, T, x0, delta, height_follows (off: the path's height)
+SEGMENT = np.array([0.7, 1.5, 0.06, 0.0, 0.38, 0.1277, -0.01, 0.03, 0.0])
 
 
 def test_min_jerk_profile_boundary_values():
@@ -34,6 +35,7 @@ def _reference(psi, psi_dot, psi_ddot, segment=SEGMENT):
     system.GetInputPort("psi_dot").FixValue(context, [psi_dot])
     system.GetInputPort("psi_ddot").FixValue(context, [psi_ddot])
     system.GetInputPort("segment").FixValue(context, segment)
+    system.GetInputPort("com_W").FixValue(context, [0.5, 0.2, 0.1])  # unread: not following
     out = system.GetOutputPort("com_reference").Eval(context)
     tangent = system.GetOutputPort("path_tangent_W").Eval(context)
     return out[:3], out[3:6], out[6:], tangent
@@ -77,9 +79,19 @@ def test_reference_is_constant_outside_its_segment():
         assert not v.any() and not a.any() and not tangent.any()
 
 
+def _slope(segment, psi):
+    """d_psi x_d as the generator gives it: no slope in z where the height follows."""
+    d_x = path(segment, psi)[1]
+    if segment[8] > 0.5:
+        d_x[2] = 0.0
+    return d_x
+
+
 def test_path_is_continuous_in_value_and_slope_across_switches():
     """Drive the state machine through states 1-4 with psi = 1.3 t and check
-    x_d and d_psi x_d just before and after every switch."""
+    x_d (the reference used: its height the CoM's where the segment follows it) and
+    d_psi x_d just before and after every switch; the CoM dips from state 2 on (as the
+    pelvis' pitch makes it), which the reference follows there."""
     cfg = StandupConfig(trigger="time")
     table = resolve_com_heights(PhaseTable(), lambda posture: 0.575)
     com0 = np.array([0.06, 0.0, 0.38])
@@ -91,7 +103,8 @@ def test_path_is_continuous_in_value_and_slope_across_switches():
         m = Measurements(
             t=t,
             psi=1.3 * t,
-            com_W=np.array([0.3, 0.0, 0.4]),  # well in front of the heels
+            # Well in front of the heels; seated at com0's height, then dipping 2 cm/s.
+            com_W=np.array([0.3, 0.0, 0.38 - 0.02 * max(t - 3.0, 0.0)]),
             heel_x=0.1,
             foot_fz_N=(200.0, 200.0),
             hand_fx_N=(0.0, 0.0),
@@ -99,14 +112,13 @@ def test_path_is_continuous_in_value_and_slope_across_switches():
         )
         new = next_mode(mode, m, cfg, table)
         if new.state != mode.state:
-            before = path(mode.segment(), m.psi)
-            after = path(new.segment(), m.psi)
-            if new.state == 3:
-                # Bumpless into state 3's stiffer height gain: the height restarts at
-                # the CoM's (transitions._enter).
-                before[0][2] = m.com_W[2]
-            np.testing.assert_allclose(after[0], before[0], atol=1e-12)  # value
-            np.testing.assert_allclose(after[1], before[1], atol=1e-12)  # slope
+            before = reference_at(mode.segment(), m.psi, m.com_W)
+            after = reference_at(new.segment(), m.psi, m.com_W)
+            np.testing.assert_allclose(after, before, atol=1e-12)  # value
+            slope = _slope(mode.segment(), m.psi)
+            np.testing.assert_allclose(_slope(new.segment(), m.psi), slope, atol=1e-12)
+            if new.state == 3:  # the height followed the dipped CoM
+                assert before[2] < 0.38 - 0.01
             segments.append(new.segment())
         mode = new
     assert mode.state == 4

@@ -374,7 +374,7 @@ def test_a_backward_pull_with_the_thighs_on_the_chair_sits_back_without_a_jump(s
     """In state 2, or in state 3 while the thighs still carry most of their load: back to
     state 1, the
     reference starting where its segment had brought it (the path evaluated
-    independently here) and returning to the seated CoM, the balancing time running
+    independently here; in state 2 at the CoM's height, which the reference follows) and returning to the seated CoM, the balancing time running
     again; state 2 waits for the return and then starts from the seated CoM, so that it
     ends where the first attempt's would have."""
     cfg = dataclasses.replace(CFG, trigger="time")
@@ -388,6 +388,8 @@ def test_a_backward_pull_with_the_thighs_on_the_chair_sits_back_without_a_jump(s
     tau = (psi - mode.psi_entry) / mode.segment_psi
     s = 10 * tau**3 - 15 * tau**4 + 6 * tau**5
     expected = np.array(mode.x_start_m) + s * np.array(mode.delta_m)
+    if state == 2:  # forward's reference height is the CoM's (com_height_follows)
+        expected[2] = AHEAD[2]
     np.testing.assert_allclose(new.x_start_m, expected, atol=1e-12)
     np.testing.assert_allclose(new.segment_end(), COM0, atol=1e-12)
     # The balancing time has run but the return has not: still seated.

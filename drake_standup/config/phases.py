@@ -8,9 +8,12 @@ posture, base orientation, lean, stance).
 
     state  phase     CoM K_P       posture        base   seat              lean  stance  psi
     1      seated    [60, 40, 5]   as it sits     0.0    held              -     -       = t
-    2      forward   [60, 40, 5]   SPEC 3 st. 2   0.4    buttocks unload   -     -       advances
+    2      forward   [60, 40, 5]*  SPEC 3 st. 2   0.4    buttocks unload   -     -       advances
     3      lift_off  [60, 40, 30]  SPEC 3 st. 3   0.3    thighs unload     yes   -       advances
     4      rise      [60, 40, 30]  SPEC 3 st. 4   0.0    off the chair     yes   yes     advances
+
+    * forward's CoM height is not tracked (com_height_follows): its reference height is
+      the measured CoM's, so the z gain only damps; state 3 starts its height there.
 
     leaves when (Guard, all of them, and no hindering pull for standup.resume_after_s):
     1 -> 2   3 s balanced, the stand-up asked for (standup.trigger)
@@ -102,6 +105,13 @@ class Phase:
     # that each model stands at its own height.
     com_height_erect: bool = False
     start_at_com_height: bool = False
+    # The reference's height is the measured CoM's all through the phase (its rate and
+    # acceleration 0: the z gain only damps the vertical motion), not the segment's: a
+    # phase that moves the CoM forward and lets its height go where the posture takes
+    # it (the pelvis' pitch dips the CoM ~5 cm in `forward`). The next segment starts at
+    # that height, where the reference is: no jump (com_path.py). Phases 2-4 (the
+    # seated phase and a sit-back's return hold the segment's height).
+    com_height_follows: bool = False
     # CoM stiffness K_P (x, y, z); K_D = 2 zeta sqrt(K_P) (controller.com_damping_ratio).
     # 1/s^2.
     com_kp_per_s2: list[float] = field(default_factory=lambda: [60.0, 40.0, 5.0])
@@ -150,6 +160,9 @@ class PhaseTable:
     # belonged to the authors' asymmetric posture, ours is symmetric), the pelvis pitched
     # forward; the buttocks lift off the seat. SPEC 3's 0.1277 m, measured from the
     # shipped seated pose, ends 8.1 mm behind the soles' frames: kept there on any seat.
+    # Its height follows the CoM: the path's z (0 displacement, K_P 5) pulled back toward
+    # the seated height while the pitch dipped the CoM, and state 3 restarted 37-66 mm
+    # lower in one step.
     forward: Phase = field(
         default_factory=lambda: Phase(
             segment_psi=1.5,
@@ -158,6 +171,7 @@ class PhaseTable:
             posture_rad=posture(
                 [1.5402, 0.1594, -1.7365, -0.2814, -1.6455, 0.4363, 0.5862, 0.2473, 1.0]
             ),
+            com_height_follows=True,
             base_pitch_rad=0.4,
             seat_hold="hinged",
             unload=["buttocks"],

@@ -54,8 +54,11 @@ class VectorLayout:
 HAND_WRENCHES = VectorLayout(("tau_l", 3), ("f_l", 3), ("tau_r", 3), ("f_r", 3))
 
 # A CoM segment of the reference (com_path.py): psi at its start, its length in psi,
-# where it starts and its displacement (world, m).
-SEGMENT = VectorLayout(("psi_entry", 1), ("psi_length", 1), ("x_start", 3), ("delta", 3))
+# where it starts and its displacement (world, m), and whether the reference's height
+# follows the measured CoM's instead of the segment's (1/0; phases.com_height_follows).
+SEGMENT = VectorLayout(
+    ("psi_entry", 1), ("psi_length", 1), ("x_start", 3), ("delta", 3), ("height_follows", 1)
+)
 
 # The CoM reference [x_d, xd_dot, xd_ddot] (world; m, m/s, m/s^2).
 COM_REFERENCE = VectorLayout(("x_d", 3), ("xd_dot", 3), ("xd_ddot", 3))

@@ -12,6 +12,12 @@ and time derivatives follow by the chain rule (SPEC 2):
     xd_ddot = d2_psi x_d * psi_dot^2 + d_psi x_d * psi_ddot.
 Segments start where the previous one ended (the state machine passes its end
 as x_start) and s', s'' vanish at both ends, so value and slope are continuous.
+
+A segment whose height follows the CoM (its height_follows entry; the phase's
+com_height_follows, config/phases.py) gives x_d[2] = the measured CoM height, its rate
+and acceleration 0: the height is not tracked there (the momentum task's z row only
+damps the vertical motion), and the next segment starts at that height, where the
+reference already is (transitions._enter).
 """
 
 from __future__ import annotations
@@ -26,10 +32,12 @@ from drake_standup.config import ComplianceConfig, ControllerConfig
 from drake_standup.control.targets import StateReferences
 from drake_standup.control.terms import RobotTerms
 from drake_standup.ports.caching import declare_cached
+from drake_standup.ports.payloads import SEGMENT
 from drake_standup.robot.balance import static_lean
 from drake_standup.robot.spatial import cross
 
-SEGMENT_SIZE = 8  # [psi_entry, T, x_start (3), delta (3)]
+SEGMENT_SIZE = SEGMENT.size  # [psi_entry, T, x_start (3), delta (3), height_follows]
+_FOLLOWS = SEGMENT.index("height_follows")
 
 
 def min_jerk(tau: float) -> tuple[float, float, float]:
@@ -47,20 +55,38 @@ def min_jerk(tau: float) -> tuple[float, float, float]:
 
 
 def path(segment: np.ndarray, psi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """x_d, d_psi x_d and d2_psi x_d of one segment at psi."""
+    """x_d, d_psi x_d and d2_psi x_d of one segment's min jerk at psi (its height as the
+    segment gives it, whether or not the height follows the CoM: see reference_at)."""
     psi_entry, T = segment[0], segment[1]
     x_start, delta = segment[2:5], segment[5:8]
     s, ds, dds = min_jerk((psi - psi_entry) / T)
     return x_start + delta * s, delta * ds / T, delta * dds / (T * T)
 
 
+def height_follows(segment: np.ndarray) -> bool:
+    """The segment's reference height is the measured CoM's (SEGMENT's height_follows)."""
+    return bool(segment[_FOLLOWS] > 0.5)
+
+
+def reference_at(segment: np.ndarray, psi: float, com_W: np.ndarray) -> np.ndarray:
+    """The reference position x_d actually used at psi with the CoM measured at com_W: the
+    segment's path, its height the CoM's where the segment's height follows it."""
+    x_d = path(segment, psi)[0]
+    if height_follows(segment):
+        x_d[2] = com_W[2]
+    return x_d
+
+
 class CoMReferenceGenerator(LeafSystem):
-    """Inputs psi, psi_dot, psi_ddot (1 each), segment (8, from the state machine).
+    """Inputs psi, psi_dot, psi_ddot (1 each), segment (payloads.SEGMENT, from the state
+    machine), com_W (3: the measured CoM, read where the segment's height follows it).
 
     Outputs com_reference (9: [x_d, xd_dot, xd_ddot], world), and x_d_W (3)
-    and path_tangent_W (3: d_psi x_d), which depend on psi and segment only,
+    and path_tangent_W (3: d_psi x_d), which depend on psi, segment and com_W only,
     so the advancement can use them without an algebraic loop; path_progress
-    (1: (psi - psi_entry) / T in [0, 1], how far along the current segment).
+    (1: (psi - psi_entry) / T in [0, 1], how far along the current segment). Where the
+    segment's height follows the CoM: x_d[2] = com_W[2], its rate, acceleration and
+    tangent 0.
     """
 
     def __init__(self):
@@ -69,6 +95,7 @@ class CoMReferenceGenerator(LeafSystem):
         self._psi_dot = self.DeclareVectorInputPort("psi_dot", 1)
         self._psi_ddot = self.DeclareVectorInputPort("psi_ddot", 1)
         self._segment = self.DeclareVectorInputPort("segment", SEGMENT_SIZE)
+        self._com = self.DeclareVectorInputPort("com_W", 3)
         # Where psi is outside its segment the path is the segment's start or end:
         # (segment bytes, end) -> path(), computed once (most of a run; read only).
         self._clamped: dict[tuple[bytes, bool], tuple[np.ndarray, ...]] = {}
@@ -78,14 +105,16 @@ class CoMReferenceGenerator(LeafSystem):
             self, "path at psi", self._calc_path, {self._psi.ticket(), self._segment.ticket()}
         )
         path_only = {self._path.ticket()}
+        # The measured height: read only while the segment's height follows it.
+        with_com = path_only | {self._segment.ticket(), self._com.ticket()}
         self.DeclareVectorOutputPort(
             "com_reference",
             9,
             self._CalcReference,
-            prerequisites_of_calc=path_only | {self._psi_dot.ticket(), self._psi_ddot.ticket()},
+            prerequisites_of_calc=with_com | {self._psi_dot.ticket(), self._psi_ddot.ticket()},
         )
         self.DeclareVectorOutputPort(
-            "x_d_W", 3, self._CalcPosition, prerequisites_of_calc=path_only
+            "x_d_W", 3, self._CalcPosition, prerequisites_of_calc=with_com
         )
         self.DeclareVectorOutputPort(
             "path_tangent_W", 3, self._CalcTangent, prerequisites_of_calc=path_only
@@ -101,29 +130,41 @@ class CoMReferenceGenerator(LeafSystem):
         tau = (psi - segment[0]) / segment[1]
         progress = min(max(tau, 0.0), 1.0)
         if not (tau <= 0.0 or tau >= 1.0):  # min_jerk's own test (NaN: computed)
-            return (*path(segment, psi), progress)
+            x_d, d_x, dd_x = path(segment, psi)
+            if height_follows(segment):  # the height is not the path's: no slope in z
+                d_x[2] = dd_x[2] = 0.0
+            return x_d, d_x, dd_x, progress
         # min_jerk is constant there: path() of the segment at its start or end.
         key = (segment.tobytes(), tau >= 1.0)
         clamped = self._clamped.get(key)
         if clamped is None:
             if len(self._clamped) > 64:
                 self._clamped.clear()
-            clamped = self._clamped[key] = path(segment, psi)
+            clamped = self._clamped[key] = path(segment, psi)  # d_x, dd_x: 0
             for array in clamped:
                 array.flags.writeable = False
         return (*clamped, progress)
 
+    def _position(self, context: Context) -> np.ndarray:
+        """x_d: the path's, its height the measured CoM's where the segment follows it."""
+        x_d = self._path.Eval(context)[0]
+        if height_follows(self._segment.Eval(context)):
+            x_d = x_d.copy()
+            x_d[2] = self._com.Eval(context)[2]
+        return x_d
+
     def _CalcReference(self, context: Context, output: BasicVector) -> None:
-        x_d, d_x, dd_x, _ = self._path.Eval(context)
+        _, d_x, dd_x, _ = self._path.Eval(context)
         psi_dot = self._psi_dot.Eval(context)[0]
         psi_ddot = self._psi_ddot.Eval(context)[0]
         output.SetFromVector(
-            np.concatenate([x_d, d_x * psi_dot, dd_x * psi_dot**2 + d_x * psi_ddot])
+            np.concatenate(
+                [self._position(context), d_x * psi_dot, dd_x * psi_dot**2 + d_x * psi_ddot]
+            )
         )
 
     def _CalcPosition(self, context: Context, output: BasicVector) -> None:
-        x_d = self._path.Eval(context)[0]
-        output.SetFromVector(x_d)
+        output.SetFromVector(self._position(context))
 
     def _CalcTangent(self, context: Context, output: BasicVector) -> None:
         d_x = self._path.Eval(context)[1]

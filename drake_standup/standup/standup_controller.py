@@ -10,7 +10,8 @@ generator and the whole-body controller.
 
 The state machine (state_machine.py) follows the phase table (config/phases.py); the
 advancement (advancement.py) integrates psi as continuous state; the CoM reference
-(com_path.py) is x_d(psi) and its derivatives; the whole-body controller (whole_body.py)
+(com_path.py) is x_d(psi) and its derivatives (its height the measured com_W's in a phase
+whose height follows the CoM); the whole-body controller (whole_body.py)
 runs the contact schedule (contact_schedule.py), the controller's model with its mass
 estimate (control/model.py), the task references (task_references.py) and the QP
 (control/controller.py) as plain objects, in one tick.
@@ -68,6 +69,7 @@ _WIRES = [
     ("com_reference", "psi_dot", "advancement", "psi_dot"),
     ("com_reference", "psi_ddot", "advancement", "psi_ddot"),
     ("com_reference", "segment", "state_machine", "segment"),
+    ("com_reference", "com_W", "", "com_W"),
     ("controller", "mode", "state_machine", "mode"),
     ("controller", "robot_state", "", "robot_state"),
     ("controller", "seat_pad_normal_forces_N", "", "seat_pad_normal_forces_N"),

@@ -35,7 +35,7 @@ import numpy as np
 from drake_standup.config import StandupConfig
 from drake_standup.config.phases import PHASES, SEAT_PAD_ROWS, SEAT_PADS, Guard, Phase, PhaseTable
 from drake_standup.control.smooth import smoothstep
-from drake_standup.standup.com_path import path
+from drake_standup.standup.com_path import reference_at
 
 N_STATES = len(PHASES)
 _NAN3 = (math.nan, math.nan, math.nan)
@@ -101,6 +101,9 @@ class StandupMode:
     segment_psi: float = 1.0
     x_start_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     delta_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    # The segment's reference height is the measured CoM's (the phase's
+    # com_height_follows; com_path.py), not x_start + delta s.
+    height_follows: bool = False
     guards: GuardSignals = GuardSignals()
     held_back_s: float = 0.0  # time spent waiting for a pull against it to stop
     held_beyond_feet_s: float = 0.0  # of which a pull beyond what the feet can hold
@@ -125,8 +128,21 @@ class StandupMode:
         return self
 
     def segment(self) -> np.ndarray:
-        """[psi_entry, T, x_start, delta] (payloads.SEGMENT)."""
-        return np.array([self.psi_entry, self.segment_psi, *self.x_start_m, *self.delta_m])
+        """[psi_entry, T, x_start, delta, height_follows] (payloads.SEGMENT)."""
+        return np.array(
+            [
+                self.psi_entry,
+                self.segment_psi,
+                *self.x_start_m,
+                *self.delta_m,
+                float(self.height_follows),
+            ]
+        )
+
+    def reference(self, psi: float, com_W: np.ndarray) -> np.ndarray:
+        """Where the CoM reference is at psi with the CoM at com_W (com_path.reference_at:
+        the segment's path, its height the CoM's where it follows the CoM)."""
+        return reference_at(self.segment(), psi, com_W)
 
     def segment_end(self) -> np.ndarray:
         return np.array(self.x_start_m) + np.array(self.delta_m)
@@ -306,8 +322,10 @@ def _sit_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupM
     and returns to where the CoM sat at the start, over phases.seated.segment_psi; state
     1's balancing time runs again from now, and its exit waits for the return. Held where
     it was instead, each later forward segment ended its offset further on and the
-    robot stood up past its toes (docs/design.md, "A pull against the stand-up")."""
-    x_now = path(mode.segment(), m.psi)[0]
+    robot stood up past its toes (docs/design.md, "A pull against the stand-up"). "Where
+    the reference is" is the one used: its height the CoM's where the segment followed
+    it; the return holds its own height (height_follows off)."""
+    x_now = mode.reference(m.psi, m.com_W)
     entry = [m.t] + [math.nan] * (N_STATES - 1)
     return dataclasses.replace(
         mode,
@@ -317,6 +335,7 @@ def _sit_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupM
         segment_psi=table.seated.segment_psi,
         x_start_m=tuple(float(v) for v in x_now),
         delta_m=tuple(float(a - b) for a, b in zip(mode.x_seated_m, x_now, strict=True)),
+        height_follows=False,
         resume_end_m=_NAN3,
         sat_back=True,
         release_s=(math.nan,) * len(SEAT_PADS),
@@ -328,8 +347,9 @@ def _step_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> Standup
     (they carry what the chair gives) and the reference stops where it is (psi = t,
     nothing advances). Once the pull has stopped, the previous phase's guard (calm among
     them) enters this phase again, whose segment then ends where the interrupted one
-    would have (docs/design.md, "A pull against the stand-up")."""
-    x_now = path(mode.segment(), m.psi)[0]
+    would have (docs/design.md, "A pull against the stand-up"). The hold keeps the height
+    of the reference used when it began (height_follows off)."""
+    x_now = mode.reference(m.psi, m.com_W)
     entry = list(mode.entry_times_s)
     entry[mode.state - 1] = math.nan
     left = table.phase(mode.state).unload
@@ -343,19 +363,24 @@ def _step_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> Standup
         segment_psi=1.0,
         x_start_m=tuple(float(v) for v in x_now),
         delta_m=(0.0, 0.0, 0.0),
+        height_follows=False,
         resume_end_m=tuple(float(v) for v in mode.segment_end()),
     )
 
 
 def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) -> StandupMode:
     """state's phase entered: its segment starts where the previous one ended (that one
-    is done, or holds still), at the CoM's height where the phase says so (bumpless: a
-    stiffer height gain would otherwise see the lean's 1-3 cm drop as a step), toward its
-    displacement (its absolute x and height where given), or where a step back left it
-    to end."""
+    is done, or holds still), at the CoM's height where the previous segment's height
+    followed the CoM (that is where the reference is) or where the phase says so
+    (bumpless: a stiffer height gain would otherwise see the lean's 1-3 cm drop as a
+    step), toward its displacement (its absolute x and height where given), or where a
+    step back left it to end; its height follows the CoM where the phase says so. Entered
+    again after a step back, it starts where the step back held the reference, at any
+    height: from the CoM's it jumped by the height the CoM lost meanwhile (11 mm in one
+    10 ms sample, measured)."""
     phase = table.phase(state)
     x_start = mode.segment_end()
-    if phase.start_at_com_height:
+    if mode.height_follows or (phase.start_at_com_height and not mode.stepped_back()):
         x_start[2] = float(m.com_W[2])
     delta = np.array(phase.com_delta_m, dtype=float)
     if phase.com_x_m is not None:
@@ -374,6 +399,7 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
         segment_psi=phase.segment_psi,
         x_start_m=tuple(float(v) for v in x_start),
         delta_m=tuple(float(v) for v in delta),
+        height_follows=phase.com_height_follows,
         resume_end_m=_NAN3,
     )
     return _begin_releases(entered, phase, m)
