@@ -58,8 +58,8 @@ def contact_specs(
         # seated, by their normal while they unload: standup/contact_schedule.py).
         ContactSpec("l_thigh", **friction, **thigh_box),
         ContactSpec("r_thigh", **friction, **thigh_box),
-        ContactSpec("l_sole", **friction, **foot_box),
-        ContactSpec("r_sole", **friction, **foot_box),
+        ContactSpec("l_sole", **friction, **foot_box, rectangle_yaw=True),
+        ContactSpec("r_sole", **friction, **foot_box, rectangle_yaw=True),
     ]
 
 
