@@ -372,11 +372,11 @@ def test_a_backward_pull_keeps_the_robot_seated():
 @pytest.mark.parametrize("state", [2, 3])
 def test_a_backward_pull_with_the_thighs_on_the_chair_sits_back_without_a_jump(state):
     """In state 2, or in state 3 while the thighs still carry most of their load: back to
-    state 1, the
-    reference starting where its segment had brought it (the path evaluated
-    independently here; in state 2 at the CoM's height, which the reference follows) and returning to the seated CoM, the balancing time running
-    again; state 2 waits for the return and then starts from the seated CoM, so that it
-    ends where the first attempt's would have."""
+    state 1, the reference starting where its segment had brought it (the path evaluated
+    independently here; in state 2 at the CoM's height, which the reference follows) and
+    returning to the seated CoM, the balancing time running again; state 2 waits for the
+    return and then starts from the seated CoM, so that it ends where the first attempt's
+    would have."""
     cfg = dataclasses.replace(CFG, trigger="time")
     mode = _in_state(state, 3.0)
     assert mode.x_seated_m == tuple(COM0)

@@ -39,16 +39,6 @@ class ControllerConfig:
     # shoulders and the knees reached their stops at 3-5 rad/s and rang the feet
     # (docs/design.md, "Chatter at the seat's release"). rad/s^2.
     joint_braking_rad_per_s2: float | None = 20.0
-    # ... but not the legs': between the base and the held soles their accelerations are
-    # the whole body's, and braking the knees at the rise's end turned the CoM's rise into
-    # the legs' hip-yaw and ankle-roll (the feet rolled; measured).
-    joint_braking_exempt: list[str] = field(
-        default_factory=lambda: [
-            f"{side}_{joint}"
-            for side in "lr"
-            for joint in ("hip_pitch", "hip_roll", "hip_yaw", "knee", "ankle_pitch", "ankle_roll")
-        ]
-    )
     # ... softly: a slack s per joint at the cost w s^2 (rad/s^2); hard bounds made the
     # QP infeasible where the soles pin the legs or the pull holds the shoulders.
     joint_limit_weight: float = 1.0e3

@@ -99,7 +99,7 @@ def make_program(
             joints.q_min,
             joints.q_max,
             config.joint_limit_horizon_s,
-            _braking(joints.names, config),
+            config.joint_braking_rad_per_s2,
         ),
         soft_bound_weight=config.joint_limit_weight,
         solver=config.qp_solver,
@@ -109,16 +109,6 @@ def make_program(
         qp=qp,
         contact_index=np.array([CONTACTS.index(spec.frame) for spec in contacts]),
         partially_held=_partially_held(contacts),
-    )
-
-
-def _braking(names: list[str], config: ControllerConfig) -> np.ndarray | None:
-    """Each joint's reserved braking (rad/s^2; inf: none), None where no joint brakes."""
-    if config.joint_braking_rad_per_s2 is None:
-        return None
-    exempt = set(config.joint_braking_exempt)
-    return np.array(
-        [np.inf if name in exempt else config.joint_braking_rad_per_s2 for name in names]
     )
 
 

@@ -113,9 +113,7 @@ class CoMReferenceGenerator(LeafSystem):
             self._CalcReference,
             prerequisites_of_calc=with_com | {self._psi_dot.ticket(), self._psi_ddot.ticket()},
         )
-        self.DeclareVectorOutputPort(
-            "x_d_W", 3, self._CalcPosition, prerequisites_of_calc=with_com
-        )
+        self.DeclareVectorOutputPort("x_d_W", 3, self._CalcPosition, prerequisites_of_calc=with_com)
         self.DeclareVectorOutputPort(
             "path_tangent_W", 3, self._CalcTangent, prerequisites_of_calc=path_only
         )

@@ -77,6 +77,7 @@ _WIRES = [
     ("controller", "hand_wrenches_W", "", "hand_wrenches_W"),
     ("controller", "com_reference", "com_reference", "com_reference"),
     ("controller", "path_progress", "com_reference", "path_progress"),
+    ("controller", "psi_dot", "advancement", "psi_dot"),
     ("controller", "response", "", "response"),
     ("advancement", "response", "", "response"),
 ]

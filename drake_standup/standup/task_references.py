@@ -105,7 +105,7 @@ class ReferenceGenerator:
         self.schedule = schedule
         self._q_joints = q_joints
         self._nu = len(schedule.q_target_min)
-        self._blend = min(period_s / config.posture_filter_time_constant_s, 1.0)
+        self._period_s = period_s
         self._latched = np.ones(1)  # the posture state's latched flag
         self.com_target = CoMTarget(
             config, period_s, gravity_mps2, compliance, standing_need, usage_limit
@@ -126,10 +126,15 @@ class ReferenceGenerator:
         return stance, 1.0 - stance * (1.0 - config.stance_vertical_weight_scale)
 
     def _posture(
-        self, terms: RobotTerms, state: StateReferences, posture: np.ndarray
+        self, terms: RobotTerms, state: StateReferences, posture: np.ndarray, psi_dot: float
     ) -> tuple[np.ndarray, np.ndarray, float]:
         """(q_ref this tick, the posture state after it, the first tick's base yaw): the
-        first tick latches the posture it finds (and the base's yaw)."""
+        first tick latches the posture it finds (and the base's yaw). The filter runs on
+        psi, never slower than time: the postures advance with the CoM path, as the
+        paper's trajectory does (psi = t: as on time); on time, a rise at psi_dot 2.5
+        reached its height with the trunk still pitched, the knees taking the rise."""
+        rate = max(psi_dot, 1.0)
+        blend = min(self._period_s * rate / self._config.posture_filter_time_constant_s, 1.0)
         nu = self._nu
         if posture[0] > 0.5:
             q_initial, q_reference = posture[1 : 1 + nu], posture[1 + nu : 1 + 2 * nu]
@@ -144,7 +149,7 @@ class ReferenceGenerator:
             state.posture_rad,
             self.schedule.q_target_min,
             self.schedule.q_target_max,
-            self._blend,
+            blend,
         )
         next_posture = np.concatenate((self._latched, q_initial, q_next, (base_yaw,)))
         return q_reference, next_posture, base_yaw
@@ -162,6 +167,7 @@ class ReferenceGenerator:
         height_integral: float = 0.0,
         response: int = ADVANCEMENT,
         compliance: np.ndarray | None = None,
+        psi_dot: float = 1.0,
     ) -> TaskReferences:
         """com_reference = [x_d, xd_dot, xd_ddot] (9,); F_hand_W = [tau_l, f_l, tau_r, f_r]
         (None: no pull); momentum_integral = int L_ang dt; posture: the posture state
@@ -170,7 +176,8 @@ class ReferenceGenerator:
         reference is, 0-1; height_integral: the stance's integral of the CoM height
         error before this tick, m s; response: ADVANCEMENT, STIFF or COMPLIANT (which of
         the pull acts, module docstring); compliance: the admittance's [offset, rate]
-        before this tick (None: at rest)."""
+        before this tick (None: at rest); psi_dot: the advancement's rate (the posture
+        filter's clock)."""
         state = self.schedule[standup_state]
         tau_hand = None if F_hand_W is None else terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
         com_target, lean, next_compliance = self.com_target.target(
@@ -195,7 +202,7 @@ class ReferenceGenerator:
             height_integral,
             F_hand_W[3:6] + F_hand_W[9:12] if helped else None,
         )
-        q_reference, next_posture, base_yaw = self._posture(terms, state, posture)
+        q_reference, next_posture, base_yaw = self._posture(terms, state, posture, psi_dot)
         return TaskReferences(
             standup_state=standup_state,
             state=state,

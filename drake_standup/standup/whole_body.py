@@ -13,7 +13,8 @@ commanded normal forces of the last tick), as the separate systems it replaces d
 
 Inputs: robot_state ([q; v]), mode (abstract StandupMode, the state machine's),
 seat_pad_normal_forces_N (3), pads_vertical_force_N (1), hand_wrenches_W (12, measured),
-com_reference (9, payloads.COM_REFERENCE), path_progress (1), response (1: the response
+com_reference (9, payloads.COM_REFERENCE), path_progress (1), psi_dot (1: the
+posture filter runs on psi; unconnected, on time), response (1: the response
 code, config.RESPONSES' index).
 Outputs: actuation (nu, N m, zero-order held), diagnostics (control/controller.py:
 DIAGNOSTICS), lean_W (3, m), compliance_W (6: the admittance's offset and rate, m, m/s),
@@ -71,6 +72,7 @@ class StandupWholeBodyController(LeafSystem):
                 ("hand_wrenches_W", HAND_WRENCHES.size),
                 ("com_reference", COM_REFERENCE.size),
                 ("path_progress", 1),
+                ("psi_dot", 1),
                 ("response", 1),
             )
         }
@@ -100,6 +102,11 @@ class StandupWholeBodyController(LeafSystem):
 
     def _input(self, name: str, context: Context) -> np.ndarray:
         return self._inputs[name].Eval(context)
+
+    def _psi_dot(self, context: Context) -> float:
+        """The advancement's rate, the posture filter's clock (unconnected: 1, time)."""
+        port = self._inputs["psi_dot"]
+        return float(port.Eval(context)[0]) if port.HasValue(context) else 1.0
 
     def _CalcEstimate(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, context.get_discrete_state(self._weighing).GetAtIndex(0))
@@ -145,6 +152,7 @@ class StandupWholeBodyController(LeafSystem):
             float(state.get_value(self._height_integral)[0]),
             int(round(self._input("response", context)[0])),
             state.get_value(self._compliance),
+            self._psi_dot(context),
         )
         tick = self.controller.solve(
             terms,
