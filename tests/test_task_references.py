@@ -109,6 +109,7 @@ def _calc(
     lean=None,
     response=ADVANCEMENT,
     compliance=None,
+    psi_dot=1.0,
 ):
     terms = rig["kinematics"].calc(rig["x"], [], HANDS if hands is not None else ())
     nu = len(rig["joints"].names)
@@ -127,6 +128,7 @@ def _calc(
         0.0,
         response,
         compliance,
+        psi_dot,
     ), reference
 
 
@@ -344,6 +346,24 @@ def test_the_lean_moves_toward_the_static_lean_in_the_phases_that_lean(rig):
     assert leaning.lean_W[0] > 0.0  # pulled back: the CoM target leans forward
     upright, _ = _calc(rig, 2, hands=hands)
     assert not upright.lean_W.any()
+
+
+@pytest.mark.parametrize("psi_dot", [0.5, 2.5])
+def test_posture_and_lean_filters_run_on_psi(rig, psi_dot):
+    """With psi advancing at psi_dot the posture reference and the lean take a filter step
+    of T max(psi_dot, 1) / tau: psi's clock, never slower than time."""
+    hands = np.tile([0.0, 0.0, 0.0, -10.0, 0.0, 0.0], 2)
+    on_time, _ = _calc(rig, 3, hands=hands)
+    on_psi, _ = _calc(rig, 3, hands=hands, psi_dot=psi_dot)
+    rate = max(psi_dot, 1.0)
+    np.testing.assert_allclose(on_psi.lean_W, rate * on_time.lean_W, rtol=1e-12)
+    nu = len(rig["joints"].names)
+    q = rig["x"][rig["joints"].q_indices]
+    step = on_time.next_posture[1 + nu : 1 + 2 * nu] - q
+    np.testing.assert_allclose(
+        on_psi.next_posture[1 + nu : 1 + 2 * nu] - q, rate * step, rtol=1e-9, atol=1e-12
+    )
+    assert np.abs(step).max() > 1e-4 and np.abs(on_time.lean_W).max() > 1e-4
 
 
 def test_the_posture_and_the_base_target_at_the_first_tick(rig):

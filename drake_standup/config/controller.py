@@ -26,7 +26,8 @@ class ControllerConfig:
     # K_D = 2 zeta sqrt(K_P) for the posture, critically damped.
     posture_damping_ratio: float = 1.0
     # q_ref moves to a new phase's posture with this first-order lag: a step would ask
-    # for large joint accelerations at each switch. s.
+    # for large joint accelerations at each switch. On psi's clock, never slower than
+    # time (standup/task_references.py). s.
     posture_filter_time_constant_s: float = 0.3
     # Posture targets are clamped this far inside the joint limits: SPEC 3's elbow target
     # 0.2473 rad lies below the URDF's 0.262 limit. rad.
@@ -119,7 +120,8 @@ class ControllerConfig:
     stance_height_ki_per_s3: float = 100.0
     # The lean's first-order lag: the pull's moment, not its jitter, and about the CoM
     # loop's own time, so that a robot leaning into a pull is upright soon after the
-    # helper lets go (docs/design.md, "The controller's settings"). s.
+    # helper lets go (docs/design.md, "The controller's settings"); on psi's clock, as the
+    # posture filter's: a rise at psi_dot 2.5 outran it (issue 30). s.
     lean_filter_time_constant_s: float = 0.2
     # Bounds of the lean: the CoM target stays over the soles' CoP box with ~1.7 cm to
     # spare, so that the robot still stands when the pull stops; a pull that needs more

@@ -215,12 +215,14 @@ class CoMTarget:
         lean_W: np.ndarray | None,
         compliance: np.ndarray,
         compliant: bool,
+        psi_dot: float = 1.0,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(the CoM target [x, xdot, xddot] (9,), the lean after this tick (3), the
         admittance's [offset, rate] after it (6)). com_reference: x_d(psi) and its
         derivatives; tau_hand = J_h^T F_hand (None: no pull); lean_W, compliance: their
-        values before the tick; compliant: the response yields to the pull."""
-        lean = self._lean(terms, state, tau_hand, lean_W)
+        values before the tick; compliant: the response yields to the pull; psi_dot: the
+        lean filter's clock, as the posture's (never slower than time)."""
+        lean = self._lean(terms, state, tau_hand, lean_W, psi_dot)
         if np.count_nonzero(lean):
             # Leaning is tilting about the feet: the CoM target keeps its distance from
             # the floor point below the unleaned target, so it drops as it leans (2 cm at
@@ -251,6 +253,7 @@ class CoMTarget:
         state: StateReferences,
         tau_hand: np.ndarray | None,
         lean_W: np.ndarray | None,
+        psi_dot: float = 1.0,
     ) -> np.ndarray:
         """tau_hand: the hands' generalized force J_h^T F_hand (None: no pull), whose first
         six entries are their resultant about the base origin (control/terms.py).
@@ -276,7 +279,7 @@ class CoMTarget:
         # count_nonzero: .any() of a 3-vector costs ~5x more (NaN counts in both).
         if not (np.count_nonzero(target) or np.count_nonzero(lean)):
             return lean
-        return lean + self._lean_blend * (target - lean)
+        return lean + min(self._lean_blend * max(psi_dot, 1.0), 1.0) * (target - lean)
 
     def offset_bounds(
         self, state: StateReferences, F_hand_W: np.ndarray, weight_N: float

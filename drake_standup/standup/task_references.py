@@ -189,6 +189,7 @@ class ReferenceGenerator:
             lean_W,
             np.zeros(6) if compliance is None else compliance,
             response == COMPLIANT,
+            psi_dot,
         )
         stance, vertical_weight_scale = self._stance(state, path_progress)
         helped = F_hand_W is not None and response == ADVANCEMENT
