@@ -44,17 +44,31 @@ def test_seated_pads_get_the_seated_bounds_and_the_phase_hold():
     assert commands.seat_hold == "held"
 
 
+def test_a_seated_pad_is_counted_on_only_as_far_as_it_carries_load():
+    """Every pad seated, measured: a thigh carrying nothing (a low seat, the thigh sloping
+    up off it) gets [0, 20]; one carrying 4 N [4, 24]; the buttocks, 150 N, [10, 170];
+    not measured, the seated bounds [10, 400]."""
+    commands = contact_commands(CONFIG, NAN3, NAN3, np.array([150.0, 0.0, 4.0]), "held")
+    np.testing.assert_array_equal(commands.min_normal_force_N[:3], [F_MIN, 0.0, 4.0])
+    np.testing.assert_array_equal(
+        commands.max_normal_force_N[:3], [150.0 + MARGIN, MARGIN, 4.0 + MARGIN]
+    )
+    np.testing.assert_array_equal(commands.min_normal_force_N[3:], [F_MIN, F_MIN])
+    unmeasured = contact_commands(CONFIG, NAN3, NAN3, None, "held")
+    np.testing.assert_array_equal(unmeasured.max_normal_force_N[:3], [SEAT_MAX] * 3)
+
+
 def test_a_releasing_pad_is_bounded_by_what_is_left_and_by_what_it_carries():
     """The buttocks with half their load left, released from 120 N, carrying 30 N: at
-    most min(0.5 x 120, 30 + 20) = 50 N, at least 0; the seated thighs keep [10, 400];
-    the seat keeps the phase's hold while the buttocks unload."""
+    most min(0.5 x 120, 30 + 20) = 50 N, at least 0; the seated thighs, carrying 55 N,
+    get [10, 55 + 20]; the seat keeps the phase's hold while the buttocks unload."""
     loads = np.array([0.5, math.nan, math.nan])
     commands = contact_commands(
         CONFIG, loads, np.array([120.0, 80.0, 80.0]), np.array([30.0, 55.0, 55.0]), "hinged"
     )
     assert commands.min_normal_force_N[0] == 0.0 and commands.max_normal_force_N[0] == 50.0
     np.testing.assert_array_equal(commands.min_normal_force_N[1:3], [F_MIN, F_MIN])
-    np.testing.assert_array_equal(commands.max_normal_force_N[1:3], [SEAT_MAX, SEAT_MAX])
+    np.testing.assert_array_equal(commands.max_normal_force_N[1:3], [55.0 + MARGIN] * 2)
     assert commands.seat_hold == "hinged" and commands.thighs_hold == "free"
     # Measured above what is left: the fraction binds (0.25 x 80 = 20 < 55 + 20).
     loads = np.array([0.0, 0.25, 0.25])

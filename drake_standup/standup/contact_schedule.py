@@ -6,7 +6,8 @@ both soles (6-D). The phase table (phases.py) says when each seat pad's load is 
 (transitions.seat_loads: what is left of it, NaN while seated). From that:
 
     chair contacts in the QP   while any seat pad is seated or still carries load
-    seated pad                 f_z in [f_min, f_max_seat]
+    seated pad                 f_z in [min(f_min, F_measured), min(f_max_seat,
+                               F_measured + margin)]
     releasing pad              f_z in [0, min(left * F_0, F_measured + margin)]
     sole                       f_z in [f_min, f_max_foot]
     seat hold                  the phase's seat_hold (seat_hold_sat_back after a sit-back)
@@ -18,7 +19,9 @@ both soles (6-D). The phase table (phases.py) says when each seat pad's load is 
 
 F_0 is what the controller commanded the pad when its release began (the schedule's
 memory: a pad lifting off cannot push). The measured bound: the thighs are forces the QP
-does not pin, and it planned on up to three times what the compliant pads carried. Why
+does not pin, and it planned on up to three times what the compliant pads carried; a
+seated pad too (on a 0.18 m seat the thighs slope up off it: the plan leaned 50-58 N on
+each while they carried none, and the robot dropped onto its feet, 209 N of chatter). Why
 the seat holds no rows once the buttocks release: docs/design.md, "Contacts".
 """
 
@@ -31,7 +34,7 @@ import numpy as np
 
 from drake_standup.config import ControllerConfig
 from drake_standup.config.phases import PhaseTable
-from drake_standup.control.contacts import CHAIR, CONTACTS, HOLDS, SOLES, ContactCommands
+from drake_standup.control.contacts import CHAIR, CONTACTS, SOLES, ContactCommands
 from drake_standup.standup.transitions import StandupMode, seat_loads, seat_releases
 
 
@@ -70,9 +73,15 @@ def contact_commands(
     low[CHAIR][releasing] = 0.0
     bound = loads[releasing] * unload_from_N[releasing]
     if measured_N is not None:
-        bound = np.minimum(
-            bound, np.maximum(measured_N[releasing], 0.0) + config.seat_measured_margin_N
+        carried = np.maximum(measured_N, 0.0)
+        bound = np.minimum(bound, carried[releasing] + config.seat_measured_margin_N)
+        # A seated pad too is counted on only as far as it carries load: on a low seat the
+        # thighs slope up off it, and the plan leaned on 50-58 N a thigh that had none.
+        seated = ~releasing
+        high[CHAIR][seated] = np.minimum(
+            high[CHAIR][seated], carried[seated] + config.seat_measured_margin_N
         )
+        low[CHAIR][seated] = np.minimum(low[CHAIR][seated], carried[seated])
     high[CHAIR][releasing] = bound
     return ContactCommands(
         active=(chair, chair, chair, True, True),
@@ -87,6 +96,11 @@ def phase_seat_hold(mode: StandupMode, table: PhaseTable) -> str:
     """How the seat holds the pelvis in mode's phase while the buttocks are seated."""
     phase = table.phase(mode.state)
     return phase.seat_hold_sat_back if mode.sat_back else phase.seat_hold
+
+
+# Every seat pad seated: no release has begun (read only).
+_SEATED = np.full(3, math.nan)
+_SEATED.flags.writeable = False
 
 
 class ContactSchedule:
@@ -104,12 +118,7 @@ class ContactSchedule:
         self._config = config
         self._table = table
         self._releases = seat_releases(table)
-        # The commands while every seat pad is seated, by hold, and once every one is
-        # released: constant, so computed once (most ticks are in one or the other).
-        seated = np.full(3, np.nan)
-        self._seated = {
-            hold: contact_commands(config, seated, seated, None, hold) for hold in HOLDS
-        }
+        # The commands once every pad is released: constant, so computed once.
         self._released = contact_commands(config, np.zeros(3), np.zeros(3), None, "free")
         self._first_release = min((release[0] for release in self._releases), default=math.inf)
 
@@ -124,11 +133,14 @@ class ContactSchedule:
         """(this tick's commands, the memory after it). mode: the state machine's;
         commanded_N: what the controller's last tick asked of CONTACTS (NaN where its QP
         failed); measured_N(): the seat pads' normal forces (3: buttocks, left and right
-        thigh pad), read only while a pad releases."""
+        thigh pad), read while any pad is on the chair."""
         commanded = commanded_N[CHAIR]
         last = commanded if np.isfinite(commanded).all() else memory[3:]
         if mode.state < self._first_release:  # every pad seated: following its commands
-            return self._seated[phase_seat_hold(mode, self._table)], np.concatenate((last, last))
+            commands = contact_commands(
+                self._config, _SEATED, _SEATED, measured_N(), phase_seat_hold(mode, self._table)
+            )
+            return commands, np.concatenate((last, last))
         loads = seat_loads(mode, t, self._releases)
         if not np.count_nonzero(loads):  # every pad released (NaN, seated, counts as nonzero)
             return self._released, np.concatenate((memory[:3], last))
