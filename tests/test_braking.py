@@ -80,21 +80,20 @@ def test_a_joint_driven_at_its_limit_stops_before_it(v0):
     assert hardest >= -A - 1e-6
 
 
-def test_exempt_joints_keep_the_horizon_bound():
-    """Per-joint braking with inf for a joint: that joint's bounds are the horizon's
-    alone; the others' are the tighter of both."""
+def test_the_bounds_are_the_tighter_of_both_and_none_keeps_the_horizon_bound():
+    """With a braking reserve each joint's bounds are the tighter of the horizon's and the
+    braking bound's; with none (braking_rad_per_s2 None) the horizon's alone."""
     rng = np.random.default_rng(5)
     n = 6
     q_min, q_max = np.full(n, -1.0), np.full(n, 1.0)
     q, v = rng.uniform(-0.8, 0.8, n), rng.uniform(-5, 5, n)
-    braking = np.array([A, np.inf, A, np.inf, A, A])
     terms = type("Terms", (), {"q": q, "v": v})()
-    bounds = JointLimitBounds(np.arange(n), np.arange(n), q_min, q_max, T, braking)
-    low, high = bounds.calc(terms)
     h_low, h_high = joint_limit_acceleration_bounds(q, v, q_min, q_max, T)
     b_low, b_high = braking_bounds(q, v, q_min, q_max, A, T)
-    exempt = np.isinf(braking)
-    np.testing.assert_array_equal(low[exempt], h_low[exempt])
-    np.testing.assert_array_equal(high[exempt], h_high[exempt])
-    np.testing.assert_allclose(low[~exempt], np.maximum(h_low, b_low)[~exempt])
-    np.testing.assert_allclose(high[~exempt], np.minimum(h_high, b_high)[~exempt])
+    low, high = JointLimitBounds(np.arange(n), np.arange(n), q_min, q_max, T, A).calc(terms)
+    np.testing.assert_allclose(low, np.maximum(h_low, b_low))
+    np.testing.assert_allclose(high, np.minimum(h_high, b_high))
+    assert np.any(high < h_high)  # the braking bound binds somewhere in this draw
+    low, high = JointLimitBounds(np.arange(n), np.arange(n), q_min, q_max, T).calc(terms)
+    np.testing.assert_array_equal(low, h_low)
+    np.testing.assert_array_equal(high, h_high)

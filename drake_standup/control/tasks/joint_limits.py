@@ -9,8 +9,7 @@ from drake_standup.control.terms import RobotTerms
 class JointLimitBounds:
     """vdot_min <= vdot[v_indices] <= vdot_max for the given joints, from their limits
     q_min, q_max and the horizon T (horizon_s): joint_limit_acceleration_bounds, tightened
-    by braking_bounds where braking_rad_per_s2 is given (one value, or one per joint; inf:
-    that joint does not brake)."""
+    by braking_bounds where braking_rad_per_s2 is given."""
 
     def __init__(
         self,
@@ -19,18 +18,13 @@ class JointLimitBounds:
         q_min: np.ndarray,
         q_max: np.ndarray,
         horizon_s: float,
-        braking_rad_per_s2: float | np.ndarray | None = None,
+        braking_rad_per_s2: float | None = None,
     ):
         self.v_indices = v_indices
         self._q, self._v = as_slice(q_indices), as_slice(v_indices)
         self._q_min, self._q_max = q_min, q_max
         self._horizon_s = horizon_s
-        self._braking = None
-        if braking_rad_per_s2 is not None:
-            braking = np.broadcast_to(np.asarray(braking_rad_per_s2, float), q_min.shape)
-            braking_joints = np.flatnonzero(np.isfinite(braking))
-            if braking_joints.size:
-                self._braking = (braking_joints, braking[braking_joints])
+        self._braking = braking_rad_per_s2
 
     def calc(self, terms: RobotTerms) -> tuple[np.ndarray, np.ndarray]:
         """(vdot_min, vdot_max) at terms' state."""
@@ -40,13 +34,10 @@ class JointLimitBounds:
         )
         if self._braking is None:
             return low, high
-        i, braking = self._braking
         brake_low, brake_high = braking_bounds(
-            q[i], qdot[i], self._q_min[i], self._q_max[i], braking, self._horizon_s
+            q, qdot, self._q_min, self._q_max, self._braking, self._horizon_s
         )
-        low[i] = np.maximum(low[i], brake_low)
-        high[i] = np.minimum(high[i], brake_high)
-        return low, high
+        return np.maximum(low, brake_low), np.minimum(high, brake_high)
 
 
 def joint_limit_acceleration_bounds(
@@ -74,7 +65,7 @@ def braking_bounds(
     qdot: np.ndarray,
     q_min: np.ndarray,
     q_max: np.ndarray,
-    braking_rad_per_s2: float | np.ndarray,
+    braking_rad_per_s2: float,
     time_constant_s: float,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Joint accelerations that keep every joint able to stop before its limit braking at
@@ -91,17 +82,14 @@ def braking_bounds(
     at (or just past) its limit, its velocity jittering about 0, sees no step between a
     braking and a free bound (such a step toggled the bound's slack 0 <-> 20 rad/s^2 tick
     by tick and rang the feet; measured). The same mirrored toward q_min."""
-    a = np.broadcast_to(np.asarray(braking_rad_per_s2, float), q.shape)
-    T = time_constant_s
+    a, T = braking_rad_per_s2, time_constant_s
     low = np.full(q.shape, -np.inf)
     high = np.full(q.shape, np.inf)
     up, down = qdot > 0.0, qdot < 0.0
     v_up = qdot[up]
-    a_up = a[up]
-    h_up = (q_max[up] - q[up]) - v_up * v_up / (2.0 * a_up)
-    high[up] = np.maximum(a_up * (h_up / (T * v_up) - 1.0), -np.minimum(a_up, v_up / T))
+    h_up = (q_max[up] - q[up]) - v_up * v_up / (2.0 * a)
+    high[up] = np.maximum(a * (h_up / (T * v_up) - 1.0), -np.minimum(a, v_up / T))
     v_down = -qdot[down]
-    a_down = a[down]
-    h_down = (q[down] - q_min[down]) - v_down * v_down / (2.0 * a_down)
-    low[down] = np.minimum(-a_down * (h_down / (T * v_down) - 1.0), np.minimum(a_down, v_down / T))
+    h_down = (q[down] - q_min[down]) - v_down * v_down / (2.0 * a)
+    low[down] = np.minimum(-a * (h_down / (T * v_down) - 1.0), np.minimum(a, v_down / T))
     return low, high
