@@ -152,8 +152,10 @@ class AdvancementConfig:
     # to 1) the law's excess over 1 is tapered to 0 (smoothstep), so psi_dot
     # returns to 1 before the path ends: the rise at psi_dot 2.5 ended on
     # straight knees and the standing robot rocked between its feet (measured;
-    # from 0.7 it still did).
-    taper_from_progress: float = 0.4
+    # from 0.7 it still did). From 0.4 the rise's reference still braked at
+    # 2.6-3.0 m/s^2 at its end and the heels slapped (up to 364 N of sole chatter);
+    # from 0.2 at 1.3-2.0 m/s^2, no slap in ten helped runs (issue 30, docs/design.md).
+    taper_from_progress: float = 0.2
     # Advance only while the CoM is not behind its reference along the path
     # (see advancement.py: without it the law and the tracker run away). The
     # tolerance admits the tracker's steady lag. m.
