@@ -5,7 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drake_standup.outputs.metrics import helper_metrics, path_deviation_max_m, standup_metrics
+from drake_standup.outputs.metrics import (
+    helper_metrics,
+    path_deviation_max_m,
+    smoothness_metrics,
+    standup_metrics,
+)
 
 PADS = {
     "l_sole_pad": "soles",
@@ -214,3 +219,59 @@ def test_path_deviation_of_a_straight_path_held_still_in_places():
     assert path_deviation_max_m(com, path) == pytest.approx(0.05)
     assert path_deviation_max_m(com[:1], path) == pytest.approx(0.02)
     assert path_deviation_max_m(com, path[:1]) == pytest.approx(0.25)  # a reference held
+
+
+def _smooth_signals(sole_total, reference=None, dt=0.01):
+    """Two soles sharing sole_total (N,) equally, a thigh pad unloaded; state 2 from 1 s."""
+    t = np.arange(len(sole_total)) * dt
+    normal = np.zeros((len(t), 3))
+    normal[:, :2] = sole_total[:, None] / 2.0
+    return {
+        "time_s": t,
+        "pad_groups": np.array(["soles", "soles", "thighs"]),
+        "pad_normal_force_N": normal,
+        "com_reference_W": np.zeros((len(t), 3)) if reference is None else reference,
+    }
+
+
+SMOOTH_ENTRIES = (0.0, 1.0, 2.0, 3.0)
+
+
+def test_chatter_is_zero_for_a_load_rising_linearly():
+    """A centred moving average reproduces a straight line: a ramp is no chatter."""
+    signals = _smooth_signals(np.linspace(0.0, 320.0, 400))
+    assert smoothness_metrics(signals, SMOOTH_ENTRIES)["sole_force_chatter_N"] == pytest.approx(
+        0.0, abs=1e-9
+    )
+
+
+def test_chatter_of_one_slap_is_its_size_less_its_share_of_the_average():
+    """One sample A above a constant load departs from the 11-sample (0.1 s at 10 ms)
+    centred average by A (1 - 1/11)."""
+    load = np.full(400, 280.0)
+    load[250] += 110.0
+    chatter = smoothness_metrics(_smooth_signals(load), SMOOTH_ENTRIES)["sole_force_chatter_N"]
+    assert chatter == pytest.approx(110.0 * (1.0 - 1.0 / 11.0))
+
+
+def test_chatter_counts_from_the_standup_start_only():
+    """A slap while seated (before state 2's entry at 1 s) is not the stand-up's; a run
+    that never left the seat has no figure."""
+    load = np.full(400, 280.0)
+    load[50] += 300.0  # at 0.5 s
+    assert smoothness_metrics(_smooth_signals(load), SMOOTH_ENTRIES)["sole_force_chatter_N"] == (
+        pytest.approx(0.0)
+    )
+    seated = smoothness_metrics(_smooth_signals(load), (0.0, None, None, None))
+    assert seated["sole_force_chatter_N"] is None
+
+
+def test_reference_step_is_the_largest_sample_to_sample_distance():
+    """A reference moving 2 mm per sample with one 3-4-0 mm jump: 5 mm."""
+    reference = np.zeros((100, 3))
+    reference[:, 0] = 0.002 * np.arange(100)
+    reference[60:, 0] += 0.003
+    reference[60:, 1] += 0.004
+    reference[60:, 0] -= 0.002  # the jump replaces that sample's 2 mm step
+    metrics = smoothness_metrics(_smooth_signals(np.full(100, 280.0), reference), SMOOTH_ENTRIES)
+    assert metrics["com_reference_max_step_m"] == pytest.approx(0.005)

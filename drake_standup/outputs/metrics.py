@@ -159,6 +159,51 @@ def path_deviation_max_m(points_W: np.ndarray, path_W: np.ndarray) -> float | No
     return worst
 
 
+def moving_average_departure(x: np.ndarray, window: int) -> np.ndarray:
+    """|x - its centred moving average over window samples (odd)| at each sample with a
+    full window (the first and last window // 2 samples have none)."""
+    half = window // 2
+    if len(x) < window:
+        return np.zeros(0)
+    mean = np.convolve(x, np.ones(window) / window, mode="valid")
+    return np.abs(x[half : len(x) - half] - mean)
+
+
+def smoothness_metrics(
+    signals: dict[str, np.ndarray], entry_times_s, window_s: float = 0.1
+) -> dict:
+    """How smoothly the feet take the load, and whether the CoM reference jumps.
+
+    sole_force_chatter_N: the soles' summed normal force's largest departure from its
+    centred window_s moving average, from the stand-up's start (state 2's entry) to the
+    end; a heel or toe slapping down shows as one sample far off the average, a load
+    rising smoothly as none. com_reference_max_step_m: the largest distance between
+    consecutive logged samples of the CoM reference (log_period_s apart). None where the
+    run never left the seat or has too few samples."""
+    t = signals["time_s"]
+    metrics: dict = {"sole_force_chatter_N": None, "com_reference_max_step_m": None}
+    if len(t) < 2:
+        return metrics
+    reference = signals["com_reference_W"]
+    metrics["com_reference_max_step_m"] = float(
+        np.linalg.norm(np.diff(reference, axis=0), axis=1).max()
+    )
+    t2 = entry_times_s[1] if len(entry_times_s) > 1 else None
+    if t2 is None or not np.isfinite(t2):
+        return metrics
+    period = float(np.median(np.diff(t)))
+    window = int(round(window_s / period)) | 1  # odd: centred
+    soles = group_normal_forces(signals).get("soles")
+    if soles is None:
+        return metrics
+    departure = moving_average_departure(soles, window)
+    centre = t[window // 2 : len(t) - window // 2]
+    after = centre >= t2 - 1e-9
+    if after.any():
+        metrics["sole_force_chatter_N"] = float(departure[after].max())
+    return metrics
+
+
 def run_metrics(
     signals: dict[str, np.ndarray],
     station,
@@ -191,6 +236,7 @@ def run_metrics(
             )
         )
         metrics["qp_failures"] = int(signals["qp_failures"][-1]) if samples else 0
+        metrics.update(smoothness_metrics(signals, metrics["state_entry_times_s"]))
     if samples and "qp_ok" in signals:
         slack = signals["joint_limit_slack"]
         metrics["joint_limit_slack_peak"] = float(slack.max())
