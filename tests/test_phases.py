@@ -46,7 +46,9 @@ controller:
 def test_the_defaults_are_the_sources_numbers():
     table = PhaseTable()
     assert [table.phase(k) for k in range(1, 5)] == list(table)
-    assert [phase.segment_psi for phase in table][1:] == [1.5, 0.5, 1.8]  # SPEC 3
+    # SPEC 3's, but state 3 over 0.7 s, not 0.5 s: its forward acceleration put the CoP
+    # past the soles' pads' middle third (issue 30, phases.py).
+    assert [phase.segment_psi for phase in table][1:] == [1.5, 0.7, 1.8]
     assert table.forward.com_delta_m == [0.1277, 0.0, 0.0]
     assert table.lift_off.com_delta_m == [0.04, 0.0, 0.0]
     assert table.seated.exit.min_time_s == 3.0 and table.seated.exit.asked
@@ -65,12 +67,14 @@ def test_an_older_file_gives_the_default_table():
     """Every older key at the value it had by default: the same table as no key at all,
     but for the standing height, which the older key sets absolute (0.575 m, where the
     default is now each model's erect height), and the forward displacement, which the
-    older key measures from the seated CoM (the default now from the soles); the keys are
-    gone from the loaded scenario (its scenario.yaml spells the table)."""
+    older key measures from the seated CoM (the default now from the soles), and state 3's
+    length, which the older key spells (0.5; the default is now 0.7); the keys are gone
+    from the loaded scenario (its scenario.yaml spells the table)."""
     older = parse_scenario(OLDER)
     expected = Scenario().phases
     expected.rise.com_height_m = 0.575
     expected.forward.com_x_over_soles_m = None
+    expected.lift_off.segment_psi = 0.5
     assert older.phases == expected
     assert not hasattr(older.standup, "segment_psi")
     assert not hasattr(older.controller, "lean_states")

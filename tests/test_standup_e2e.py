@@ -68,6 +68,15 @@ def test_assisted_stands_up_sooner(assisted, unassisted):
     assert m["standup_time_s"] < m["standup_time_s_without_advancement"]
 
 
+def test_the_feet_take_the_load_without_slapping(assisted, unassisted):
+    """Issue 30: from the stand-up's start the soles' summed normal force stays within
+    40 N of its centred 0.1 s moving average (no heel or toe slapping down), and the CoM
+    reference moves at most 10 mm between logged samples, alone and helped."""
+    for _, m in (assisted, unassisted):
+        assert m["sole_force_chatter_N"] <= 40.0
+        assert m["com_reference_max_step_m"] <= 0.010
+
+
 @pytest.fixture(scope="module", params=["stiff", "compliant"])
 def other_response(request, tmp_path_factory):
     """The assisted scenario's pull answered by stiff or compliant (config.RESPONSES)."""

@@ -114,7 +114,8 @@ def test_2_to_3_guards():
 
 def test_3_to_4_needs_each_foot():
     mode = _in_state(3, 5.0)
-    t_ok = 5.0 + LIFT_OFF.exit.min_time_s
+    # The latest of: the phase's minimum time, the thighs' release, the segment's end.
+    t_ok = 5.0 + max(LIFT_OFF.exit.min_time_s, LIFT_OFF.unload_s, LIFT_OFF.segment_psi)
     thr = LIFT_OFF.exit.each_foot_force_N
     assert _next(mode, _m(t_ok, feet=(thr + 1e-9, thr + 1e-9)), CFG).state == 4
     assert _next(mode, _m(t_ok, feet=(thr, 500.0)), CFG).state == 3
