@@ -68,13 +68,15 @@ def test_an_older_file_gives_the_default_table():
     but for the standing height, which the older key sets absolute (0.575 m, where the
     default is now each model's erect height), and the forward displacement, which the
     older key measures from the seated CoM (the default now from the soles), and state 3's
-    length, which the older key spells (0.5; the default is now 0.7); the keys are gone
+    length and its thighs' release, which the older keys spell (0.5 s each; the defaults
+    are now 0.7 s); the keys are gone
     from the loaded scenario (its scenario.yaml spells the table)."""
     older = parse_scenario(OLDER)
     expected = Scenario().phases
     expected.rise.com_height_m = 0.575
     expected.forward.com_x_over_soles_m = None
     expected.lift_off.segment_psi = 0.5
+    expected.lift_off.unload_s = 0.5
     assert older.phases == expected
     assert not hasattr(older.standup, "segment_psi")
     assert not hasattr(older.controller, "lean_states")
