@@ -69,8 +69,8 @@ def test_an_older_file_gives_the_default_table():
     default is now each model's erect height), and the forward displacement, which the
     older key measures from the seated CoM (the default now from the soles), and state 3's
     length and its thighs' release, which the older keys spell (0.5 s each; the defaults
-    are now 0.7 s); the keys are gone
-    from the loaded scenario (its scenario.yaml spells the table)."""
+    are now 0.7 s); the keys are gone from the loaded scenario (its scenario.yaml spells
+    the table)."""
     older = parse_scenario(OLDER)
     expected = Scenario().phases
     expected.rise.com_height_m = 0.575

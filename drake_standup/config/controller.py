@@ -82,8 +82,9 @@ class ControllerConfig:
     min_normal_force_N: float = 10.0
     # A seated pad's normal-force bound: above the robot's weight (324 N), never binding. N.
     seat_max_normal_force_N: float = 400.0
-    # A releasing seat pad is also bounded by its measured normal force plus this
-    # (standup/contact_schedule.py): the QP planned on more than the compliant pads carried. N.
+    # Every seat pad, seated or releasing, is also bounded by its measured normal force plus
+    # this (standup/contact_schedule.py): the QP planned on more than the compliant pads
+    # carried, and on a low seat leaned on thighs that carried nothing. N.
     seat_measured_margin_N: float = 20.0
     # Sole normal-force bound: three times the robot's weight, never binding. N.
     foot_max_normal_force_N: float = 1000.0
