@@ -20,6 +20,7 @@ from drake_standup.studies.sweep_file import (
     MAX_RUNS,
     SweepError,
     check_run_count,
+    columns,
     expand,
     load_sweep,
 )
@@ -66,6 +67,35 @@ def test_grid_expands_every_combination_onto_every_named_key(tmp_path):
         assert scenario.human.pulls[1].force_N == [run.params["pull"], 0.0, run.params["pull"]]
         assert scenario.human.pulls[0].hand == base.human.pulls[0].hand
     assert len({r.run_id for r in runs}) == len(runs)
+
+
+def test_a_grid_entrys_companions_go_with_its_values(tmp_path):
+    """with: the k-th value of each companion key goes with the entry's k-th value, in
+    every combination, and is a column of its own."""
+    text = GRID.replace(
+        "    values: [0, 10, 20]\n",
+        "    values: [0, 10, 20]\n    with: {standup.trigger: [time, hands, hands]}\n",
+    )
+    spec = load_sweep(_write(tmp_path, text))
+    assert columns(spec) == ["pull", "standup.trigger", "advancement.psi_dot_upper"]
+    runs = expand(spec)
+    assert len(runs) == 3 * 2
+    base = load_scenario(SCENARIO_DIR / "assisted.yaml")
+    for run in runs:
+        expected = "time" if run.params["pull"] == 0 else "hands"
+        assert run.params["standup.trigger"] == expected
+        assert apply_overrides(base, run.overrides).standup.trigger == expected
+
+
+@pytest.mark.parametrize("companions", ["{standup.trigger: [time, hands]}", "[time]"])
+def test_a_companion_list_of_the_wrong_length_is_one_error_line(tmp_path, companions):
+    text = GRID.replace(
+        "    values: [0, 10, 20]\n", f"    values: [0, 10, 20]\n    with: {companions}\n"
+    )
+    with pytest.raises(SweepError) as err:
+        load_sweep(_write(tmp_path, text))
+    assert "grid[0].with:" in str(err.value) and "one per entry of values" in str(err.value)
+    assert "\n" not in str(err.value)
 
 
 RANDOM = """

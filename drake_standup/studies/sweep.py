@@ -26,7 +26,14 @@ from drake_standup.config.arguments import OneLineErrorParser
 from drake_standup.outputs.json_files import write_json
 from drake_standup.studies.cluster import run_on_cluster
 from drake_standup.studies.sweep_figures import draw_figure
-from drake_standup.studies.sweep_file import RunSpec, SweepError, SweepSpec, expand, load_sweep
+from drake_standup.studies.sweep_file import (
+    RunSpec,
+    SweepError,
+    SweepSpec,
+    columns,
+    expand,
+    load_sweep,
+)
 from drake_standup.studies.sweep_table import write_table
 
 EXAMPLE = "example: drake-standup sweep assistance --limit 2 --out out/sweeps/try"
@@ -144,7 +151,7 @@ def run_sweep(
 
     ordered = [records[r.run_id] for r in runs]
     table = out_dir / "results.csv"
-    write_table(table, ordered, [p.name for p in spec.grid + spec.random])
+    write_table(table, ordered, columns(spec))
     figures = [draw_figure(fig, ordered, out_dir) for fig in spec.figures]
     return SweepResult(runs, records, table, [f for f in figures if f], computed, wall_s)
 

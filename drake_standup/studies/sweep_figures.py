@@ -51,13 +51,15 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
         if fig.group:
             ax.legend(fontsize=8)
         ax.set_ylabel(fig.y)
+        # Below the x axis' label, where no data point can lie under it.
         ax.text(
-            0.01,
-            0.01,
+            0.0,
+            -0.2,
             "lines: mean over runs that stood up; x: a run that failed, at its value or,\n"
             "without one, on the x axis (reason in results.csv)",
             transform=ax.transAxes,
             fontsize=7,
+            va="top",
         )
     else:
         xs = np.array([r[fig.x] for r in rows], dtype=float)

@@ -46,6 +46,9 @@ class Parameter:
     paths: list[str]
     values: list | None = None  # grid
     draw: dict | None = None  # random: {'uniform': [a, b]} | {'normal': [m, s]} | {'choice': [...]}
+    # grid: key paths set along with this column, their k-th value with values[k]
+    # (e.g. the stand-up's trigger that goes with a pull); a column each in the table.
+    with_: dict[str, list] = field(default_factory=dict)
 
 
 @dataclass
@@ -146,7 +149,7 @@ def load_sweep(path: str | Path) -> SweepSpec:
         perturbations=perturbations,
         figures=[_figure(f"figures[{i}]", f) for i, f in enumerate(figures)],
     )
-    names = [p.name for p in spec.grid + spec.random]
+    names = columns(spec)
     if len(set(names)) != len(names):
         raise SweepError(f"grid/random: a column name is used twice in {names}")
     spec.runs = expand(spec)  # every key path and value checked against the base now
@@ -169,6 +172,15 @@ def _integer(where: str, value, low: int) -> int:
     return value
 
 
+def columns(spec) -> list[str]:
+    """The parameter columns of the sweep's table: each grid and random parameter's name,
+    each grid entry's companions (with) after it."""
+    names = []
+    for p in spec.grid:
+        names += [p.name, *p.with_]
+    return names + [p.name for p in spec.random]
+
+
 def _number(value) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
@@ -185,7 +197,9 @@ def _parameters(raw: dict, key: str) -> list[Parameter]:
     params = []
     for i, entry in enumerate(entries):
         where = f"{key}[{i}]"
-        _known(where, entry, ("name", "path", "paths", kind))
+        _known(
+            where, entry, ("name", "path", "paths", kind) + (("with",) if kind == "values" else ())
+        )
         paths = entry.get("paths", entry.get("path"))
         paths = [paths] if isinstance(paths, str) else paths
         if not paths or not isinstance(paths, list) or not all(isinstance(p, str) for p in paths):
@@ -197,7 +211,18 @@ def _parameters(raw: dict, key: str) -> list[Parameter]:
             raise SweepError(f"{where}.values: {value!r}; accepted: a non-empty list")
         if kind == "draw":
             _check_draw(f"{where}.draw", value, constant_ok=False)
-        params.append(Parameter(entry.get("name", paths[0]), paths, **{kind: value}))
+        companions = entry.get("with") or {}
+        if not isinstance(companions, dict) or not all(
+            isinstance(path, str) and isinstance(v, list) and len(v) == len(value)
+            for path, v in companions.items()
+        ):
+            raise SweepError(
+                f"{where}.with: {companions!r}; accepted: key path: a list of "
+                f"{len(value)} values (one per entry of values)"
+            )
+        params.append(
+            Parameter(entry.get("name", paths[0]), paths, **{kind: value}, with_=companions)
+        )
     return params
 
 
@@ -307,8 +332,16 @@ def expand(spec: SweepSpec) -> list[RunSpec]:
         p.name: [c for path in p.paths for c in _paths(base, path, p.name)]
         for p in spec.grid + spec.random
     }
-    names = [param.name for param in spec.grid]
-    combos = [dict(zip(names, v)) for v in itertools.product(*(p.values for p in spec.grid))]
+    for p in spec.grid:
+        for path in p.with_:
+            paths[path] = [c for c in _paths(base, path, f"{p.name}.with.{path}")]
+    combos = []
+    for picks in itertools.product(*(range(len(p.values)) for p in spec.grid)):
+        combo = {}
+        for p, k in zip(spec.grid, picks, strict=True):
+            combo[p.name] = p.values[k]
+            combo.update({path: values[k] for path, values in p.with_.items()})
+        combos.append(combo)
     runs = []
     for index, combo in enumerate([c for c in combos for _ in range(spec.samples)]):
         rng = np.random.default_rng([spec.seed, index])
