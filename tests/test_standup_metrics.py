@@ -8,6 +8,7 @@ import pytest
 from drake_standup.outputs.metrics import (
     helper_metrics,
     path_deviation_max_m,
+    seated_rest_metrics,
     smoothness_metrics,
     standup_metrics,
 )
@@ -275,3 +276,27 @@ def test_reference_step_is_the_largest_sample_to_sample_distance():
     reference[60:, 0] -= 0.002  # the jump replaces that sample's 2 mm step
     metrics = smoothness_metrics(_smooth_signals(np.full(100, 280.0), reference), SMOOTH_ENTRIES)
     assert metrics["com_reference_max_step_m"] == pytest.approx(0.005)
+
+
+def test_seated_rest_measures_the_slide_and_the_drop_before_the_standup_only():
+    """A base that sinks 1 mm and slides 3-4 mm sideways and forward while seated (5 mm),
+    then moves 0.3 m once state 2 has begun (at 1 s): 5 mm of slide, 1 mm of drop, the
+    pads' loads at 1 s; the window ends at 3 s when the stand-up never starts."""
+    signals = _smooth_signals(np.full(400, 280.0))
+    t = signals["time_s"]
+    base = np.zeros((len(t), 3))
+    base[:, 2] = 0.39
+    base[t >= 0.5, 2] -= 0.001
+    base[t >= 0.6, 0] += 0.003
+    base[t >= 0.7, 1] += 0.004
+    base[t > 1.0, 0] += 0.3
+    signals["base_position_W"] = base
+    signals["pad_normal_force_N"][:, 2] = np.where(t <= 1.0, 120.0, 0.0)
+    rest = seated_rest_metrics(signals, SMOOTH_ENTRIES)
+    assert rest["seated_slide_m"] == pytest.approx(0.005)
+    assert rest["seated_drop_m"] == pytest.approx(0.001)
+    assert rest["seated_normal_force_N"] == pytest.approx({"soles": 280.0, "thighs": 120.0})
+    never = seated_rest_metrics(signals, (0.0, None, None, None))
+    # The 0.3 m move at 1 s lies inside the 3 s window.
+    assert never["seated_slide_m"] == pytest.approx(np.hypot(0.303, 0.004))
+    assert never["seated_normal_force_N"]["thighs"] == 0.0

@@ -169,6 +169,35 @@ def moving_average_departure(x: np.ndarray, window: int) -> np.ndarray:
     return np.abs(x[half : len(x) - half] - mean)
 
 
+def seated_rest_metrics(
+    signals: dict[str, np.ndarray], entry_times_s, window_s: float = 3.0
+) -> dict:
+    """Whether the robot sat at rest before it stood up (issue 30): over the first
+    window_s, or until the stand-up's start (state 2's entry) if sooner, the base's
+    largest horizontal distance from where the run started (seated_slide_m) and its
+    largest drop below it (seated_drop_m); and the normal force on each pad group (soles,
+    thighs, buttocks) at the window's last sample (seated_normal_force_N). Empty without
+    samples."""
+    t = signals["time_s"]
+    if not len(t) or "base_position_W" not in signals:
+        return {}
+    end = window_s
+    t2 = entry_times_s[1] if entry_times_s is not None and len(entry_times_s) > 1 else None
+    if t2 is not None and np.isfinite(t2):
+        end = min(end, t2)
+    seated = t <= end + 1e-9
+    base = signals["base_position_W"][seated]
+    slide = np.linalg.norm(base[:, :2] - base[0, :2], axis=1)
+    last = int(np.count_nonzero(seated)) - 1
+    return {
+        "seated_slide_m": float(slide.max()),
+        "seated_drop_m": float(max(0.0, (base[0, 2] - base[:, 2]).max())),
+        "seated_normal_force_N": {
+            group: float(fz[last]) for group, fz in group_normal_forces(signals).items()
+        },
+    }
+
+
 def smoothness_metrics(
     signals: dict[str, np.ndarray], entry_times_s, window_s: float = 0.1
 ) -> dict:
@@ -237,6 +266,7 @@ def run_metrics(
         )
         metrics["qp_failures"] = int(signals["qp_failures"][-1]) if samples else 0
         metrics.update(smoothness_metrics(signals, metrics["state_entry_times_s"]))
+        metrics.update(seated_rest_metrics(signals, metrics["state_entry_times_s"]))
     if samples and "qp_ok" in signals:
         slack = signals["joint_limit_slack"]
         metrics["joint_limit_slack_peak"] = float(slack.max())
