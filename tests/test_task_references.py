@@ -419,3 +419,14 @@ def test_the_generator_integrates_the_angular_momentum_over_its_ticks(rig):
         lean = references.lean_W
     np.testing.assert_allclose(integral, 4 * T * L, atol=1e-12)
     np.testing.assert_array_equal(lean, np.zeros(3))
+
+
+def test_the_psi_clock_blend_is_a_first_order_step_never_slower_than_time():
+    """One step of dt / tau of the gap at psi = t, psi_dot times that ahead of time, the
+    time step below psi_dot 1, and never past the target (1)."""
+    from drake_standup.control.smooth import psi_clock_blend
+
+    assert psi_clock_blend(0.01, 0.2, 1.0) == pytest.approx(0.05)
+    assert psi_clock_blend(0.01, 0.2, 2.5) == pytest.approx(0.125)
+    assert psi_clock_blend(0.01, 0.2, 0.3) == pytest.approx(0.05)
+    assert psi_clock_blend(0.3, 0.2, 1.0) == 1.0

@@ -22,6 +22,7 @@ reference already is (transitions._enter).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 
@@ -29,6 +30,7 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
 from drake_standup.config import ComplianceConfig, ControllerConfig
+from drake_standup.control.smooth import psi_clock_blend
 from drake_standup.control.targets import StateReferences
 from drake_standup.control.terms import RobotTerms
 from drake_standup.ports.caching import declare_cached
@@ -203,7 +205,9 @@ class CoMTarget:
             stiffness,
             np.array(compliance.max_offset_m),
         )
-        self._lean_blend = min(period_s / config.lean_filter_time_constant_s, 1.0)
+        self._lean_blend = functools.partial(
+            psi_clock_blend, period_s, config.lean_filter_time_constant_s
+        )
 
     def target(
         self,
@@ -279,7 +283,7 @@ class CoMTarget:
         # count_nonzero: .any() of a 3-vector costs ~5x more (NaN counts in both).
         if not (np.count_nonzero(target) or np.count_nonzero(lean)):
             return lean
-        return lean + min(self._lean_blend * max(psi_dot, 1.0), 1.0) * (target - lean)
+        return lean + self._lean_blend(psi_dot) * (target - lean)
 
     def offset_bounds(
         self, state: StateReferences, F_hand_W: np.ndarray, weight_N: float

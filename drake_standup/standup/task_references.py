@@ -36,7 +36,7 @@ import numpy as np
 
 from drake_standup.config import RESPONSES, ComplianceConfig, ControllerConfig
 from drake_standup.config.phases import PhaseTable
-from drake_standup.control.smooth import smoothstep
+from drake_standup.control.smooth import psi_clock_blend, smoothstep
 from drake_standup.control.targets import StateReferences, TaskReferences, joint_values
 from drake_standup.control.tasks import BaseTarget, MomentumLaw, next_posture_reference
 from drake_standup.control.terms import RobotTerms
@@ -133,8 +133,9 @@ class ReferenceGenerator:
         psi, never slower than time: the postures advance with the CoM path, as the
         paper's trajectory does (psi = t: as on time); on time, a rise at psi_dot 2.5
         reached its height with the trunk still pitched, the knees taking the rise."""
-        rate = max(psi_dot, 1.0)
-        blend = min(self._period_s * rate / self._config.posture_filter_time_constant_s, 1.0)
+        blend = psi_clock_blend(
+            self._period_s, self._config.posture_filter_time_constant_s, psi_dot
+        )
         nu = self._nu
         if posture[0] > 0.5:
             q_initial, q_reference = posture[1 : 1 + nu], posture[1 + nu : 1 + 2 * nu]
