@@ -169,3 +169,34 @@ def test_the_forward_target_follows_the_feet(height):
     if height == 0.2195:
         com = plant.CalcCenterOfMassPositionInWorld(context, [station.scene.robot.model_instance])
         assert forward.com_x_m - com[0] == pytest.approx(0.1277, abs=5e-4)
+
+
+def test_the_lift_off_postures_move_with_the_seated_pose():
+    """resolve_postures shifts the flagged phases' joints by the seat's shift and keeps
+    them inside the limits; others as given. On a 0.18 m seat the plan's state-2 knee is
+    the seated knee (SPEC 3's state 2 keeps the knees as they sit), on the shipped seat
+    SPEC 3's numbers to 1 mrad."""
+    from drake_standup.config.phases import PhaseTable, resolve_postures
+    from drake_standup.standup.plan import feet_reach, make_plan
+    from drake_standup.world.station import make_station
+
+    table = PhaseTable()
+    shifted = resolve_postures(
+        table, {"l_knee": -0.3, "l_hip_pitch": 0.5}, {"l_hip_pitch": (-0.5, 1.9)}, 0.05
+    )
+    assert shifted.forward.posture_rad["l_knee"] == table.forward.posture_rad["l_knee"] - 0.3
+    assert shifted.forward.posture_rad["l_hip_pitch"] == pytest.approx(1.85)  # clamped
+    assert shifted.lift_off.posture_rad["l_knee"] == table.lift_off.posture_rad["l_knee"] - 0.3
+    assert shifted.rise.posture_rad == table.rise.posture_rad
+    assert shifted.forward.posture_rad["r_knee"] == table.forward.posture_rad["r_knee"]
+    for height in (0.18, 0.2195):
+        scenario = apply_overrides(load_scenario("assisted"), [("chair.seat_height_m", height)])
+        station = make_station(scenario, feet_reach(scenario.controller))
+        plan = make_plan(scenario, station)
+        knee = station.scene.seated.joints_rad["l_knee"]
+        assert plan.table.forward.posture_rad["l_knee"] == pytest.approx(knee, abs=1e-12)
+        if height == 0.2195:
+            for name in ("forward", "lift_off"):
+                planned = getattr(plan.table, name).posture_rad
+                for joint, value in getattr(PhaseTable(), name).posture_rad.items():
+                    assert planned[joint] == pytest.approx(value, abs=1e-3), (name, joint)

@@ -28,6 +28,7 @@ of this table as separate keys of standup: and controller: (config/legacy.py rea
 """
 
 import copy
+import math
 from dataclasses import dataclass, field
 
 # The phases in the order of the stand-up states 1-4.
@@ -118,6 +119,12 @@ class Phase:
     # Posture target by joint name; a joint not named holds the posture of the first
     # tick. rad.
     posture_rad: dict[str, float] = field(default_factory=dict)
+    # The posture's seated leg joints (hip pitch, knee, ankle pitch: those the seating
+    # solves) move with the seated pose: posture_rad holds their targets for the shipped
+    # seated pose (config.chair.SEATED_JOINTS), and the plan adds how far the robot's own
+    # seated pose differs from it (resolve_postures), so a phase keeps SPEC 3's motion
+    # from the seat wherever the robot sits. False: posture_rad as it is.
+    posture_from_seated: bool = False
     # Forward pitch of the base's (root_link's) target orientation. rad.
     base_pitch_rad: float = 0.0
     # How the seat contact holds the pelvis while the buttocks are seated: held (all six
@@ -171,6 +178,7 @@ class PhaseTable:
             posture_rad=posture(
                 [1.5402, 0.1594, -1.7365, -0.2814, -1.6455, 0.4363, 0.5862, 0.2473, 1.0]
             ),
+            posture_from_seated=True,
             com_height_follows=True,
             base_pitch_rad=0.4,
             seat_hold="hinged",
@@ -195,6 +203,7 @@ class PhaseTable:
             posture_rad=posture(
                 [1.1097, 0.0122, -0.8365, -0.0714, -1.4615, 0.4363, 0.1545, 0.2018, 0.0611]
             ),
+            posture_from_seated=True,
             base_pitch_rad=0.3,
             seat_hold="hinged",
             unload=["thighs"],
@@ -265,4 +274,28 @@ def resolve_com_heights(table: PhaseTable, erect_height_m) -> PhaseTable:
     for name in table.unresolved_heights():
         phase = getattr(resolved, name)
         phase.com_height_m = float(erect_height_m(phase.posture_rad))
+    return resolved
+
+
+def resolve_postures(
+    table: PhaseTable,
+    shift_rad: dict[str, float],
+    limits_rad: dict[str, tuple[float, float]],
+    margin_rad: float,
+) -> PhaseTable:
+    """A copy of table whose posture_from_seated phases have each joint of shift_rad (the
+    robot's seated pose minus the shipped one, by joint name) moved by that much, kept
+    margin_rad inside limits_rad (joint name -> (lower, upper)) where those allow it."""
+    resolved = copy.deepcopy(table)
+    for phase in resolved:
+        if not phase.posture_from_seated:
+            continue
+        for name, shift in shift_rad.items():
+            if name not in phase.posture_rad:
+                continue
+            target = phase.posture_rad[name] + shift
+            low, high = limits_rad.get(name, (-math.inf, math.inf))
+            if high - low > 2.0 * margin_rad:
+                target = min(max(target, low + margin_rad), high - margin_rad)
+            phase.posture_rad[name] = target
     return resolved

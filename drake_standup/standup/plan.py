@@ -11,8 +11,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from drake_standup.config import ControllerConfig, Scenario
-from drake_standup.config.phases import PHASES, PhaseTable, resolve_com_heights, resolve_com_x
-from drake_standup.world.scene import erect_com_height_m
+from drake_standup.config.chair import SEATED_JOINTS
+from drake_standup.config.phases import (
+    PHASES,
+    PhaseTable,
+    resolve_com_heights,
+    resolve_com_x,
+    resolve_postures,
+)
+from drake_standup.world.scene import Scene, erect_com_height_m
+from drake_standup.world.seating import JOINT_MARGIN_RAD, LEG_JOINTS
 from drake_standup.world.sensing import FeetReach
 from drake_standup.world.station import Station
 
@@ -56,11 +64,28 @@ def _posture_key(posture_rad: dict[str, float]) -> tuple:
     return tuple(sorted(posture_rad.items()))
 
 
+def seated_shift(scene: Scene) -> tuple[dict[str, float], dict[str, tuple[float, float]]]:
+    """(how far the robot's seated leg joints (seating.LEG_JOINTS, both sides) are from
+    the shipped seated pose's, and those joints' limits), rad, by joint name."""
+    plant, instance = scene.plant, scene.robot.model_instance
+    shift, limits = {}, {}
+    for side in "lr":
+        for joint in LEG_JOINTS:
+            name = f"{side}_{joint}"
+            if name not in scene.seated.joints_rad or not plant.HasJointNamed(name, instance):
+                continue
+            shift[name] = scene.seated.joints_rad[name] - SEATED_JOINTS[name]
+            j = plant.GetJointByName(name, instance)
+            limits[name] = (j.position_lower_limits()[0], j.position_upper_limits()[0])
+    return shift, limits
+
+
 def make_plan(scenario: Scenario, station: Station) -> StandupPlan:
     """The plan for scenario's robot in the station's scene: the forward ends from where the
-    soles are seated (resolve_com_x); each standing posture's CoM height from forward
-    kinematics (scene.erect_com_height_m), once per distinct posture; the rise's is the
-    station's own where it stands erect (its standing support)."""
+    soles are seated (resolve_com_x); the lift-off's postures from the seated pose
+    (resolve_postures); each standing posture's CoM height from forward kinematics
+    (scene.erect_com_height_m), once per distinct posture; the rise's is the station's
+    own where it stands erect (its standing support)."""
     rise = scenario.phases.rise
     heights: dict[tuple, float] = {}
     if rise.com_height_m is None:
@@ -74,5 +99,7 @@ def make_plan(scenario: Scenario, station: Station) -> StandupPlan:
 
     seated = station.scene.seated
     soles_x = scenario.chair.seat_edge_x_m() + seated.feet_ahead_of_seat_edge_m
-    table = resolve_com_heights(resolve_com_x(scenario.phases, soles_x), erect)
+    shift, limits = seated_shift(station.scene)
+    table = resolve_postures(scenario.phases, shift, limits, JOINT_MARGIN_RAD)
+    table = resolve_com_heights(resolve_com_x(table, soles_x), erect)
     return StandupPlan(table, erect(scenario.phases.rise.posture_rad))
