@@ -127,6 +127,9 @@ def test_an_older_posture_merges_into_the_phases_posture():
     scenario = parse_scenario("controller:\n  posture_state2_rad: {l_knee: -1.5}\n")
     expected = dict(PhaseTable().forward.posture_rad, l_knee=-1.5)
     assert scenario.phases.forward.posture_rad == expected
+    # Absolute, as then: the plan moves no joint of it with the seated pose.
+    assert PhaseTable().forward.posture_from_seated
+    assert not scenario.phases.forward.posture_from_seated
 
 
 def test_the_phases_section_sets_the_table():

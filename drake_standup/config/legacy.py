@@ -62,8 +62,15 @@ _LEGACY: dict[str, tuple[object, _Writes]] = {
         "state",
         lambda v: {k: {"seat_hold": "hinged" if k >= v else "held"} for k in _STATES},
     ),
-    "controller.posture_state2_rad": ("joints", lambda v: {2: {"posture_rad": v}}),
-    "controller.posture_state3_rad": ("joints", lambda v: {3: {"posture_rad": v}}),
+    # An old file's postures are absolute (the plan moved none with the seated pose then).
+    "controller.posture_state2_rad": (
+        "joints",
+        lambda v: {2: {"posture_rad": v, "posture_from_seated": False}},
+    ),
+    "controller.posture_state3_rad": (
+        "joints",
+        lambda v: {3: {"posture_rad": v, "posture_from_seated": False}},
+    ),
     "controller.posture_state4_rad": ("joints", lambda v: {4: {"posture_rad": v}}),
     "controller.lean_states": ("states", lambda v: {k: {"lean": k in v} for k in _STATES}),
 }
