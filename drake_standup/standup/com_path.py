@@ -22,7 +22,6 @@ reference already is (transitions._enter).
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable
 
@@ -205,9 +204,6 @@ class CoMTarget:
             stiffness,
             np.array(compliance.max_offset_m),
         )
-        self._lean_blend = functools.partial(
-            psi_clock_blend, period_s, config.lean_filter_time_constant_s
-        )
 
     def target(
         self,
@@ -283,7 +279,8 @@ class CoMTarget:
         # count_nonzero: .any() of a 3-vector costs ~5x more (NaN counts in both).
         if not (np.count_nonzero(target) or np.count_nonzero(lean)):
             return lean
-        return lean + self._lean_blend(psi_dot) * (target - lean)
+        blend = psi_clock_blend(self._period_s, self._config.lean_filter_time_constant_s, psi_dot)
+        return lean + blend * (target - lean)
 
     def offset_bounds(
         self, state: StateReferences, F_hand_W: np.ndarray, weight_N: float

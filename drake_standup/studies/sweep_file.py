@@ -334,7 +334,7 @@ def expand(spec: SweepSpec) -> list[RunSpec]:
     }
     for p in spec.grid:
         for path in p.with_:
-            paths[path] = [c for c in _paths(base, path, f"{p.name}.with.{path}")]
+            paths[path] = _paths(base, path, f"{p.name}.with.{path}")
     combos = []
     for picks in itertools.product(*(range(len(p.values)) for p in spec.grid)):
         combo = {}
