@@ -1,5 +1,6 @@
 """The human: scripted pulls reach the plant exactly; physics agrees; the
-reactive helper pulls toward its target within its force cap; the path guide
+reactive helper pulls toward its target within its force cap, follows a hand
+that outruns it, lets go, and acts on what it saw its reaction time ago; the path guide
 walks the hand at its pace, never yanks, never pulls backwards or sideways,
 and eases off (each against numbers written out by hand)."""
 
@@ -21,7 +22,8 @@ from drake_standup.config import (
     parse_scenario,
 )
 from drake_standup.sim.diagram import build_diagram
-from drake_standup.world.human import HumanWrenchSource, Path, path_force, reactive_force, trapezoid
+from drake_standup.world.human import HumanWrenchSource
+from drake_standup.world.partner import Path, path_force, reactive_force, trapezoid
 
 PULLS = [
     Pull(hand="left", start_s=1.0, duration_s=2.0, ramp_s=0.5, force_N=[20.0, 0.0, 10.0]),
@@ -100,18 +102,78 @@ def test_reactive_human_pulls_toward_target_within_cap():
     cfg = ReactiveHumanConfig(start_s=1.0, duration_s=5.0, ramp_s=0.5, force_cap_N=20.0)
     start = np.array([0.24, 0.01, 0.31])
     assert not reactive_force(cfg, 0.9, start, np.zeros(3), start).any()
-    # Mid-pull, hand still at the start: pulled along the target's direction
-    # (0.5 s of target travel: 10.6 N, under the cap).
+    # Mid-pull, hand still at the start: pulled along the pace's direction u, by the
+    # spring to the pace point (0.5 s of it: 10.6 N) and the damping to its speed.
     f = reactive_force(cfg, 1.5, start, np.zeros(3), start)
-    direction = np.array(cfg.target_velocity_mps) / np.linalg.norm(cfg.target_velocity_mps)
-    travel = np.linalg.norm(cfg.target_velocity_mps) * 0.5
-    np.testing.assert_allclose(f, cfg.stiffness_N_per_m * travel * direction, rtol=1e-12)
-    # Far from the target: capped.
+    v_pace = np.array(cfg.target_velocity_mps)
+    direction = v_pace / np.linalg.norm(v_pace)
+    travel = np.linalg.norm(v_pace) * 0.5
+    expected = cfg.stiffness_N_per_m * travel * direction + cfg.damping_Ns_per_m * v_pace
+    np.testing.assert_allclose(f, expected, rtol=1e-12)
+    # Far behind the target: capped.
     f = reactive_force(cfg, 5.5, start - 1.0, np.zeros(3), start)
     assert np.linalg.norm(f) == pytest.approx(20.0 * trapezoid(5.5, 1.0, 5.0, 0.5))
-    # Hand moving toward the target: damping reduces the pull.
-    f_moving = reactive_force(cfg, 1.5, start, 0.1 * direction, start)
-    assert np.linalg.norm(f_moving) < cfg.stiffness_N_per_m * travel
+    # Hand moving along with the target: only the spring is left.
+    f_moving = reactive_force(cfg, 1.5, start, v_pace, start)
+    np.testing.assert_allclose(f_moving, cfg.stiffness_N_per_m * travel * direction, rtol=1e-12)
+
+
+# --- the velocity guide is a person (issue 31) -----------------------------------
+# Pace along u = (0.6, 0, 0.8) at 0.1 m/s from t = 1 s, K 100 N/m, D 10 N s/m, cap 50 N.
+U = np.array([0.6, 0.0, 0.8])
+P0 = np.array([0.24, 0.11, 0.31])
+
+
+def _person(**kw) -> ReactiveHumanConfig:
+    values = dict(
+        start_s=1.0,
+        duration_s=10.0,
+        ramp_s=0.5,
+        stiffness_N_per_m=100.0,
+        damping_Ns_per_m=10.0,
+        force_cap_N=50.0,
+        target_velocity_mps=list(0.1 * U),
+        travel_m=0.3,
+    )
+    values.update(kw)
+    return ReactiveHumanConfig(**values)
+
+
+def test_person_follows_a_hand_that_outruns_them():
+    """At t = 2 s the pace is 0.1 m along u. A hand seen 0.2 m along u, moving at 0.5
+    m/s, is not pulled back: the target is where it was seen, moving as it was."""
+    cfg, v = _person(), 0.5 * U
+    seen = P0 + 0.2 * U
+    assert not reactive_force(cfg, 2.0, seen, v, P0, (seen, v)).any()
+    # Seen 0.15 s ago, it has moved on 0.075 m since: the person lags by as much, and
+    # their arm pulls it back by K 0.075 (7.5 N), the damping adding nothing.
+    now = seen + 0.075 * U
+    np.testing.assert_allclose(
+        reactive_force(cfg, 2.0, now, v, P0, (seen, v)), -7.5 * U, atol=1e-12
+    )
+
+
+def test_person_guides_along_u_not_back_to_a_line():
+    """A hand at rest 0.1 m sideways of the start, at t = 1.5 s (pace 0.05 m): pulled
+    K 0.05 + D 0.1 along u and nothing sideways (the first model pulled it back in y)."""
+    hand = P0 + np.array([0.0, 0.1, 0.0])
+    f = reactive_force(_person(), 1.5, hand, np.zeros(3), P0)
+    np.testing.assert_allclose(f, (100.0 * 0.05 + 10.0 * 0.1) * U, atol=1e-12)
+
+
+def test_person_stops_at_their_travel_and_lets_go_once_the_robot_is_up():
+    cfg = _person()
+    # After 0.3 m (t = 4 s) the person stops: a hand 0.1 m short is pulled K 0.1 along
+    # u, the damping holding it (the target still); a hand beyond is followed.
+    np.testing.assert_allclose(
+        reactive_force(cfg, 5.0, P0 + 0.2 * U, np.zeros(3), P0), 10.0 * U, atol=1e-12
+    )
+    assert not reactive_force(cfg, 5.0, P0 + 0.4 * U, np.zeros(3), P0).any()
+    # The CoM's rise: full pull below 0.07 m, half at 0.105 m, none from 0.14 m.
+    full = reactive_force(cfg, 2.0, P0, np.zeros(3), P0, com_rise_m=0.05)
+    half = reactive_force(cfg, 2.0, P0, np.zeros(3), P0, com_rise_m=0.105)
+    np.testing.assert_allclose(half, 0.5 * full, atol=1e-12)
+    assert not reactive_force(cfg, 2.0, P0, np.zeros(3), P0, com_rise_m=0.14).any()
 
 
 # --- guide: path ---------------------------------------------------------------
@@ -302,3 +364,55 @@ def test_bad_path_keys_are_one_line_errors_naming_the_key(body, key):
         parse_scenario(text, "test")
     message = str(err.value)
     assert "\n" not in message and message.startswith(key) and "accepted" in message
+
+
+def test_person_acts_on_what_they_saw_their_reaction_time_ago():
+    """The person's decisions read the hands as they were reaction_time_s (0.2 s) ago:
+    the arms move at t = 0 (the robot's state switched from A to B); until 0.2 s the
+    force is the person's answer to A's hands acting on B's, from then on to B's."""
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_standup.robot.icub import ContactModel, add_icub
+
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=1e-3)
+    robot = add_icub(plant, visuals=False, contact=ContactModel())
+    plant.Finalize()
+    cfg = _person(start_s=0.0, ramp_s=0.0, reaction_time_s=0.2)
+    human = HumanWrenchSource(plant, robot, HumanConfig(mode="reactive", reactive=cfg))
+    context = plant.CreateDefaultContext()
+    x_a = plant.GetPositionsAndVelocities(context, robot.model_instance)
+    x_b = x_a.copy()
+    for name in ("l_shoulder_pitch", "r_shoulder_pitch", "l_elbow", "r_elbow"):
+        x_b[plant.GetJointByName(name, robot.model_instance).position_start()] += 0.3
+
+    def hands(x):
+        plant.SetPositionsAndVelocities(context, robot.model_instance, x)
+        frames = [robot.frame(plant, name) for name in ("l_hand", "r_hand")]
+        com = plant.CalcCenterOfMassPositionInWorld(context, [robot.model_instance])[2]
+        return [f.CalcPoseInWorld(context).translation() for f in frames], com
+
+    (p_a, com_a), (p_b, com_b) = hands(x_a), hands(x_b)
+    simulator = Simulator(human)
+    root = simulator.get_mutable_context()
+    port = human.GetInputPort("robot_state")
+    port.FixValue(root, x_a)
+    simulator.Initialize()  # the hands at the start, and all the person has seen: A
+    port.FixValue(root, x_b)
+
+    def force(t):
+        simulator.AdvanceTo(t)
+        return human.GetOutputPort("hand_wrenches_W").Eval(root).reshape(2, 6)[:, 3:]
+
+    zero = np.zeros(3)
+
+    def expected(t, seen, rise):
+        return [reactive_force(cfg, t, p_b[i], zero, p_a[i], (seen[i], zero), rise) for i in (0, 1)]
+
+    np.testing.assert_allclose(force(0.19), expected(0.19, p_a, 0.0), atol=1e-12)
+    late = force(0.21)
+    np.testing.assert_allclose(late, expected(0.21, p_b, com_b - com_a), atol=1e-12)
+    # Not vacuous: what the person saw changes the pull by more than a newton.
+    assert np.abs(late - np.array(expected(0.21, p_a, 0.0))).max() > 1.0

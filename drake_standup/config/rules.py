@@ -98,6 +98,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         NON_NEGATIVE,
         "human.pulls[*].start_s human.pulls[*].ramp_s "
         "human.reactive.start_s human.reactive.ramp_s human.reactive.stiffness_N_per_m "
+        "human.reactive.reaction_time_s "
         "human.reactive.damping_Ns_per_m human.reactive.travel_m "
         "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
         "human.reactive.ease_com_rise_m advancement.alpha_*_mps2 advancement.lag_tolerance_m "

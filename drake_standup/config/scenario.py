@@ -65,10 +65,13 @@ class ReactiveHumanConfig:
     """A helper who guides each hand; the pull fades in and out over ramp_s
     (SPEC 3: the authors' human pulled 10-25 N per hand).
 
-    guide: velocity (the first model, the default so that older scenario files
-    keep their meaning): F = sat(K (p_target - p_hand) - D v_hand, force_cap_N),
-    the target leaving the hand's position at start_s with velocity
-    target_velocity_mps for at most travel_m.
+    Both guides are a person (issue 31, SPEC 10): they decide on what they saw
+    reaction_time_s ago, follow a hand that outruns them and let go once the robot
+    is up (ease_com_rise_m).
+    guide: velocity (the default): a person moving each hand along the direction
+    of target_velocity_mps at its speed, for at most travel_m, from wherever they
+    saw the hand (human.py, reactive_force): F = sat(K (p_target - p_hand) +
+    D (v_target - v_hand), force_cap_N).
     guide: path (human.py, path_force): a person walking each hand along a path
     in the sagittal plane (path_xz_m from where the hand was) at pace_mps, never
     more than lead_max_m ahead of the hand, never less than lead_min_m while the
@@ -78,6 +81,10 @@ class ReactiveHumanConfig:
     """
 
     guide: str = "velocity"
+    # What the person does is decided on what they felt this long ago: a person's simple
+    # reaction time to a felt force is about 0.15-0.25 s (SPEC 10); their arm's impedance
+    # acts at once. 0: the instant spring of the first models. s.
+    reaction_time_s: float = 0.2
     start_s: float = 3.0
     duration_s: float = 8.0
     ramp_s: float = 0.5

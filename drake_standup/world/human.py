@@ -1,14 +1,9 @@
 """HumanWrenchSource: the helper's hands on the robot's hands.
 
 Two humans: 'scripted' applies the scenario's pulls (trapezoids in time, each
-on one hand, constant world direction); 'reactive' guides each hand, like a
-person helping the robot up, in one of two ways (reactive.guide):
-- velocity: an impedance pulling toward a target that leaves from where the
-  hand was and moves up and forward at a constant velocity, force capped.
-- path: a person walking the hand along a path at a human pace, following the
-  robot: the target stays between lead_min and lead_max ahead of the hand
-  along the path, the pull acts along the path only and only forwards along
-  it, capped, and eases off once the robot is up (path_force).
+on one hand, constant world direction); 'reactive' is a person guiding each hand
+(partner.py: the velocity and the path guide), who acts on what they saw of the
+robot reaction_time_s ago (this system keeps it) through their arm's impedance.
 The wrench acts at the origin of the hand task frame (the hand's DH frame).
 """
 
@@ -22,11 +17,16 @@ from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
-from drake_standup.config import HumanConfig, Pull, ReactiveHumanConfig
+from drake_standup.config import HumanConfig, Pull
 from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.icub import Robot
+from drake_standup.world.partner import Path, path_force, reactive_force, trapezoid
 
 HANDS = {"left": 0, "right": 1}
+# What a reactive person perceives, every PERCEPTION_PERIOD_S: the hands' positions (6)
+# and velocities (6) and the robot's CoM height (1). s.
+PERCEIVED = 13
+PERCEPTION_PERIOD_S = 0.01
 TASK_FRAMES = ("l_hand", "r_hand")
 # HelperWork's output, entry by entry (signals.npz and metrics.json name them so).
 HELPER_SPENT = (
@@ -63,16 +63,6 @@ def spatial_forces(
     return pulled
 
 
-def trapezoid(t: float, start_s: float, duration_s: float, ramp_s: float) -> float:
-    """0 -> 1 over ramp_s from start_s, 1, then 1 -> 0 over the last ramp_s."""
-    local = t - start_s
-    if local <= 0.0 or local >= duration_s:
-        return 0.0
-    if ramp_s <= 0.0:
-        return 1.0
-    return min(1.0, local / ramp_s, (duration_s - local) / ramp_s)
-
-
 def scripted_forces(pulls: list[Pull], t: float) -> np.ndarray:
     """(2, 3) world forces on the left and right hand at time t. N."""
     forces = np.zeros((2, 3))
@@ -80,146 +70,6 @@ def scripted_forces(pulls: list[Pull], t: float) -> np.ndarray:
         scale = trapezoid(t, pull.start_s, pull.duration_s, pull.ramp_s)
         forces[HANDS[pull.hand]] += scale * np.asarray(pull.force_N)
     return forces
-
-
-def reactive_force(
-    cfg: ReactiveHumanConfig, t: float, p_hand: np.ndarray, v_hand: np.ndarray, p_start: np.ndarray
-) -> np.ndarray:
-    """Impedance pull of one hand toward its moving target, capped. N."""
-    scale = trapezoid(t, cfg.start_s, cfg.duration_s, cfg.ramp_s)
-    if scale == 0.0:
-        return np.zeros(3)
-    v_target = np.asarray(cfg.target_velocity_mps)
-    speed = np.linalg.norm(v_target)
-    travel = min(speed * (t - cfg.start_s), cfg.travel_m)
-    direction = v_target / speed if speed > 0 else np.zeros(3)
-    target = p_start + travel * direction
-    f = cfg.stiffness_N_per_m * (target - p_hand) - cfg.damping_Ns_per_m * v_hand
-    norm = np.linalg.norm(f)
-    if norm > cfg.force_cap_N:
-        f *= cfg.force_cap_N / norm
-    return scale * f
-
-
-# Largest turn of one segment of a rounded corner: a hand 0.1 m inside the
-# arc sees its closest point jump 2 (0.1 m) tan(0.5 deg) = 1.7 mm per vertex. rad.
-ARC_STEP_RAD = math.radians(1.0)
-
-
-def _round_corners(points: np.ndarray, radius: float) -> np.ndarray:
-    """points with each interior corner replaced by a circular arc of radius
-    (less where a leg is too short: the arc takes at most half of each leg),
-    as segments turning ARC_STEP_RAD at most."""
-    if radius <= 0.0 or len(points) < 3:
-        return points
-    out = [points[0]]
-    for before, corner, after in zip(points[:-2], points[1:-1], points[2:]):
-        a, b = corner - before, after - corner
-        la, lb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
-        a, b = a / la, b / lb
-        turn = math.acos(min(1.0, max(-1.0, float(a @ b))))
-        if turn < 1e-6 or turn > math.pi - 1e-6:
-            out.append(corner)
-            continue
-        cut = min(radius * math.tan(turn / 2), 0.5 * la, 0.5 * lb)
-        r = cut / math.tan(turn / 2)
-        centre = corner + (r / math.cos(turn / 2)) * (b - a) / float(np.linalg.norm(b - a))
-        u0, u1 = corner - cut * a - centre, corner + cut * b - centre
-        phi0 = math.atan2(u0[1], u0[0])
-        sweep = (math.atan2(u1[1], u1[0]) - phi0 + math.pi) % (2 * math.pi) - math.pi
-        n = max(1, math.ceil(abs(sweep) / ARC_STEP_RAD))
-        for k in range(n + 1):
-            phi = phi0 + sweep * k / n
-            out.append(centre + r * np.array([math.cos(phi), math.sin(phi)]))
-    out.append(points[-1])
-    return np.array(out)
-
-
-class Path:
-    """A polyline in the sagittal (x, z) plane from [0, 0] through waypoints,
-    its corners rounded to corner_radius_m, parametrised by arc length s.
-
-    Rounded, the hand's closest point moves continuously as the hand passes
-    inside a corner (at a sharp corner it jumps from one leg to the next, and
-    the pull's direction with it) as long as the hand stays closer to the path
-    than the radius."""
-
-    def __init__(self, waypoints_xz: list[list[float]], corner_radius_m: float = 0.0):
-        sharp = np.vstack([np.zeros(2), np.asarray(waypoints_xz, dtype=float)])
-        self.points = _round_corners(sharp, corner_radius_m)
-        self.lengths = np.linalg.norm(np.diff(self.points, axis=0), axis=1)
-        self.s_start = np.concatenate([[0.0], np.cumsum(self.lengths)])
-        self.length = float(self.s_start[-1])
-        self.tangents = np.diff(self.points, axis=0) / self.lengths[:, None]
-
-    def point(self, s: float) -> np.ndarray:
-        """The path's point at arc length s (clamped to the path). (x, z)."""
-        s = min(max(s, 0.0), self.length)
-        i = min(int(np.searchsorted(self.s_start, s, side="right")) - 1, len(self.lengths) - 1)
-        return self.points[i] + (s - self.s_start[i]) * self.tangents[i]
-
-    def project(self, p: np.ndarray) -> tuple[float, np.ndarray]:
-        """(s, unit tangent) of the path's point closest to p (x, z); of two
-        equally close, the first along the path."""
-        a = self.points[:-1]
-        u = np.clip(np.einsum("ij,ij->i", p - a, self.tangents), 0.0, self.lengths)
-        d = np.linalg.norm(p - (a + u[:, None] * self.tangents), axis=1)
-        i = int(np.argmin(d))
-        return float(self.s_start[i] + u[i]), self.tangents[i]
-
-
-def _xz(v: np.ndarray) -> np.ndarray:
-    return np.array([v[0], v[2]])
-
-
-def path_force(
-    cfg: ReactiveHumanConfig,
-    path: Path,
-    t: float,
-    p_hand: np.ndarray,
-    v_hand: np.ndarray,
-    p_start: np.ndarray,
-    com_rise_m: float,
-) -> np.ndarray:
-    """A person walking one hand along path (from p_start), capped. World, N.
-
-    The hand's progress s_h is its closest point on the path (its sideways
-    position is ignored). The person's own progress would be pace (t - start),
-    but they never get more than lead_max ahead of the hand (no yank) and
-    keep at least lead_min ahead (they follow a hand that outruns them with a
-    light pull), never past the path's end:
-        s_t = min(L, clip(pace (t - start), s_h + lead_min, s_h + lead_max)).
-    The pull K (s_t - s_h) + D (ds_t/dt - ds_h/dt), clipped to [0, cap], acts
-    along the path from the hand's closest point toward the target's point
-    (the path's tangent, turning with it through a corner): only forwards
-    along the path, no force across it or sideways. It fades in and out with
-    the trapezoid (start_s, duration_s, ramp_s) and fades out while the CoM
-    rises through ease_com_rise_m.
-    """
-    scale = trapezoid(t, cfg.start_s, cfg.duration_s, cfg.ramp_s)
-    low, high = cfg.ease_com_rise_m
-    scale *= min(1.0, max(0.0, (high - com_rise_m) / (high - low)))
-    if scale == 0.0:
-        return np.zeros(3)
-    s_hand, tangent = path.project(_xz(p_hand - p_start))
-    s_dot_hand = float(_xz(v_hand) @ tangent)
-    s_pace = cfg.pace_mps * (t - cfg.start_s)
-    if s_pace > s_hand + cfg.lead_max_m:  # the person waits for the hand
-        s_target, s_dot_target = s_hand + cfg.lead_max_m, s_dot_hand
-    elif s_pace < s_hand + cfg.lead_min_m:  # the person follows the hand
-        s_target, s_dot_target = s_hand + cfg.lead_min_m, s_dot_hand
-    else:
-        s_target, s_dot_target = s_pace, cfg.pace_mps
-    if s_target >= path.length:  # the person stops at the path's end
-        s_target, s_dot_target = path.length, 0.0
-    pull = cfg.stiffness_N_per_m * (s_target - s_hand) + cfg.damping_Ns_per_m * (
-        s_dot_target - s_dot_hand
-    )
-    pull = min(max(pull, 0.0), cfg.force_cap_N)
-    chord = path.point(s_target) - path.point(s_hand)
-    norm = float(np.linalg.norm(chord))
-    direction = chord / norm if norm > 1e-9 else tangent
-    return scale * pull * np.array([direction[0], 0.0, direction[1]])
 
 
 class HumanWrenchSource(LeafSystem):
@@ -250,6 +100,12 @@ class HumanWrenchSource(LeafSystem):
                 r = config.reactive
                 self._path = Path(r.path_xz_m, r.path_corner_radius_m)
             self._start_index = self.DeclareDiscreteState(7)
+            # What the person saw: one sample (PERCEIVED) per PERCEPTION_PERIOD_S over
+            # their reaction time, oldest first; they act on the oldest.
+            self._slots = round(config.reactive.reaction_time_s / PERCEPTION_PERIOD_S)
+            if self._slots:
+                self._seen_index = self.DeclareDiscreteState(PERCEIVED * (self._slots + 1))
+                self.DeclarePeriodicDiscreteUpdateEvent(PERCEPTION_PERIOD_S, 0.0, self._Perceive)
             self.DeclareInitializationDiscreteUpdateEvent(self._CaptureStart)
             prereq |= {self._state.ticket(), self.all_state_ticket()}
         # The scripted pulls are a function of time alone: the last time and
@@ -296,9 +152,21 @@ class HumanWrenchSource(LeafSystem):
         com = self._plant.CalcCenterOfMassPositionInWorld(self._context, [self._instance])
         return float(com[2])
 
+    def _sample(self, context: Context) -> np.ndarray:
+        """(PERCEIVED,) the hands' positions and velocities and the CoM height now."""
+        p, v = self._hands(context)
+        return np.concatenate([*p, *v, [self._com_height()]])
+
     def _CaptureStart(self, context: Context, discrete_state) -> None:
-        p, _ = self._hands(context)
-        discrete_state.set_value(self._start_index, np.concatenate([*p, [self._com_height()]]))
+        sample = self._sample(context)
+        discrete_state.set_value(self._start_index, np.concatenate([sample[:6], sample[12:]]))
+        if self._slots:  # seen at rest until then
+            discrete_state.set_value(self._seen_index, np.tile(sample, self._slots + 1))
+
+    def _Perceive(self, context: Context, discrete_state) -> None:
+        seen = discrete_state.get_mutable_value(self._seen_index)
+        seen[:-PERCEIVED] = seen[PERCEIVED:].copy()
+        seen[-PERCEIVED:] = self._sample(context)
 
     def _forces(self, context: Context) -> np.ndarray:
         """(2, 3) world forces on the left and right hand. N."""
@@ -311,13 +179,21 @@ class HumanWrenchSource(LeafSystem):
         if not r.start_s < t < r.start_s + r.duration_s:
             return np.zeros((2, 3))  # no kinematics needed outside the pull
         p, v = self._hands(context)
+        seen = [None, None]
+        rise = self._com_height() - captured[6]
+        if self._slots:  # what the person saw reaction_time_s ago
+            oldest = context.get_discrete_state(self._seen_index).value()[:PERCEIVED]
+            seen = [(oldest[3 * i : 3 * i + 3], oldest[6 + 3 * i : 9 + 3 * i]) for i in range(2)]
+            rise = oldest[12] - captured[6]
         if self._path is not None:
-            rise = self._com_height() - captured[6]
             return np.array(
-                [path_force(r, self._path, t, p[i], v[i], start[i], rise) for i in range(2)]
+                [
+                    path_force(r, self._path, t, p[i], v[i], start[i], rise, seen[i])
+                    for i in range(2)
+                ]
             )
         return np.array(
-            [reactive_force(self._cfg.reactive, t, p[i], v[i], start[i]) for i in range(2)]
+            [reactive_force(r, t, p[i], v[i], start[i], seen[i], rise) for i in range(2)]
         )
 
     def _wrenches(self, context: Context) -> np.ndarray:
