@@ -124,13 +124,15 @@ U = np.array([0.6, 0.0, 0.8])
 P0 = np.array([0.24, 0.11, 0.31])
 
 
+# The pull's timing and the arm's impedance both guides' tests share.
+_ARM = dict(
+    start_s=1.0, duration_s=10.0, ramp_s=0.5, stiffness_N_per_m=100.0, damping_Ns_per_m=10.0
+)
+
+
 def _person(**kw) -> ReactiveHumanConfig:
     values = dict(
-        start_s=1.0,
-        duration_s=10.0,
-        ramp_s=0.5,
-        stiffness_N_per_m=100.0,
-        damping_Ns_per_m=10.0,
+        **_ARM,
         force_cap_N=50.0,
         target_velocity_mps=list(0.1 * U),
         travel_m=0.3,
@@ -185,12 +187,8 @@ DIR = np.array([0.6, 0.0, 0.8])
 
 def _path_cfg(**kw) -> ReactiveHumanConfig:
     values = dict(
+        **_ARM,
         guide="path",
-        start_s=1.0,
-        duration_s=10.0,
-        ramp_s=0.5,
-        stiffness_N_per_m=100.0,
-        damping_Ns_per_m=10.0,
         force_cap_N=100.0,
         path_xz_m=[[0.6, 0.8]],
         pace_mps=0.2,
