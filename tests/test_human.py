@@ -146,12 +146,12 @@ def test_person_follows_a_hand_that_outruns_them():
     m/s, is not pulled back: the target is where it was seen, moving as it was."""
     cfg, v = _person(), 0.5 * U
     seen = P0 + 0.2 * U
-    assert not reactive_force(cfg, 2.0, seen, v, P0, (seen, v)).any()
+    assert not reactive_force(cfg, 2.0, seen, v, P0, seen=(seen, v)).any()
     # Seen 0.15 s ago, it has moved on 0.075 m since: the person lags by as much, and
     # their arm pulls it back by K 0.075 (7.5 N), the damping adding nothing.
     now = seen + 0.075 * U
     np.testing.assert_allclose(
-        reactive_force(cfg, 2.0, now, v, P0, (seen, v)), -7.5 * U, atol=1e-12
+        reactive_force(cfg, 2.0, now, v, P0, seen=(seen, v)), -7.5 * U, atol=1e-12
     )
 
 
@@ -407,7 +407,7 @@ def test_person_acts_on_what_they_saw_their_reaction_time_ago():
     zero = np.zeros(3)
 
     def expected(t, seen, rise):
-        return [reactive_force(cfg, t, p_b[i], zero, p_a[i], (seen[i], zero), rise) for i in (0, 1)]
+        return [reactive_force(cfg, t, p_b[i], zero, p_a[i], rise, (seen[i], zero)) for i in (0, 1)]
 
     np.testing.assert_allclose(force(0.19), expected(0.19, p_a, 0.0), atol=1e-12)
     late = force(0.21)

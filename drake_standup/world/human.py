@@ -179,12 +179,12 @@ class HumanWrenchSource(LeafSystem):
         if not r.start_s < t < r.start_s + r.duration_s:
             return np.zeros((2, 3))  # no kinematics needed outside the pull
         p, v = self._hands(context)
-        seen = [None, None]
-        rise = self._com_height() - captured[6]
         if self._slots:  # what the person saw reaction_time_s ago
             oldest = context.get_discrete_state(self._seen_index).value()[:PERCEIVED]
             seen = [(oldest[3 * i : 3 * i + 3], oldest[6 + 3 * i : 9 + 3 * i]) for i in range(2)]
             rise = oldest[12] - captured[6]
+        else:
+            seen, rise = [None, None], self._com_height() - captured[6]
         if self._path is not None:
             return np.array(
                 [
@@ -193,7 +193,7 @@ class HumanWrenchSource(LeafSystem):
                 ]
             )
         return np.array(
-            [reactive_force(r, t, p[i], v[i], start[i], seen[i], rise) for i in range(2)]
+            [reactive_force(r, t, p[i], v[i], start[i], rise, seen[i]) for i in range(2)]
         )
 
     def _wrenches(self, context: Context) -> np.ndarray:

@@ -41,8 +41,8 @@ def reactive_force(
     p_hand: np.ndarray,
     v_hand: np.ndarray,
     p_start: np.ndarray,
-    seen: tuple[np.ndarray, np.ndarray] | None = None,
     com_rise_m: float = 0.0,
+    seen: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """A person guiding one hand along the direction u of target_velocity_mps, capped. N.
 
