@@ -102,8 +102,8 @@ def standup_metrics(
     not_standing = np.r_[0, np.cumsum(~standing)]
     last = np.searchsorted(t, t + hold_s - 1e-9, side="right") - 1
     held = (not_standing[last + 1] - not_standing[:-1] == 0) & (t[-1] >= t + hold_s - 1e-9)
-    t2 = entry_times_s[1]
-    if t2 is not None and np.isfinite(t2):
+    t2 = standup_start_s(entry_times_s)
+    if t2 is not None:
         held &= t >= t2
         if held.any():
             metrics["standup_time_s"] = float(t[np.argmax(held)] - t2)
@@ -169,6 +169,12 @@ def moving_average_departure(x: np.ndarray, window: int) -> np.ndarray:
     return np.abs(x[half : len(x) - half] - mean)
 
 
+def standup_start_s(entry_times_s) -> float | None:
+    """State 2's entry time, the stand-up's start (None: the run never left the seat)."""
+    t2 = entry_times_s[1] if entry_times_s is not None and len(entry_times_s) > 1 else None
+    return float(t2) if t2 is not None and np.isfinite(t2) else None
+
+
 def seated_rest_metrics(
     signals: dict[str, np.ndarray], entry_times_s, window_s: float = 3.0
 ) -> dict:
@@ -181,10 +187,8 @@ def seated_rest_metrics(
     t = signals["time_s"]
     if not len(t) or "base_position_W" not in signals:
         return {}
-    end = window_s
-    t2 = entry_times_s[1] if entry_times_s is not None and len(entry_times_s) > 1 else None
-    if t2 is not None and np.isfinite(t2):
-        end = min(end, t2)
+    t2 = standup_start_s(entry_times_s)
+    end = window_s if t2 is None else min(window_s, t2)
     seated = t <= end + 1e-9
     base = signals["base_position_W"][seated]
     slide = np.linalg.norm(base[:, :2] - base[0, :2], axis=1)
@@ -217,8 +221,8 @@ def smoothness_metrics(
     metrics["com_reference_max_step_m"] = float(
         np.linalg.norm(np.diff(reference, axis=0), axis=1).max()
     )
-    t2 = entry_times_s[1] if len(entry_times_s) > 1 else None
-    if t2 is None or not np.isfinite(t2):
+    t2 = standup_start_s(entry_times_s)
+    if t2 is None:
         return metrics
     period = float(np.median(np.diff(t)))
     window = int(round(window_s / period)) | 1  # odd: centred
