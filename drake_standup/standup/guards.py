@@ -1,0 +1,134 @@
+"""The guards' signals: the forces the stand-up's guards read, low-pass filtered (first
+order, standup.force_filter_time_constant_s), through Schmitt triggers: a condition turns
+on once its filtered force has stayed above the threshold for guard_dwell_s, and off once
+it has stayed below guard_off_ratio times the threshold as long, so noise around a
+threshold cannot flip it back and forth. Pure functions; transitions.py's next_mode reads
+them, state_machine.py wraps both in a Drake system.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from drake_standup.config import StandupConfig
+from drake_standup.config.phases import PHASES, PhaseTable
+
+N_STATES = len(PHASES)
+
+
+@dataclass(frozen=True)
+class SchmittTrigger:
+    """A condition with hysteresis and dwell: on after the value has stayed above the on
+    threshold for the dwell, off after it has stayed below the off threshold as long."""
+
+    on: bool = False
+    # Since when the value has been past the threshold that would flip the trigger
+    # (NaN: it is not).
+    pending_since_s: float = math.nan
+
+    def update(
+        self, value: float, t: float, on_above: float, off_below: float, dwell_s: float
+    ) -> SchmittTrigger:
+        crossing = value < off_below if self.on else value > on_above
+        if not crossing:
+            return self if math.isnan(self.pending_since_s) else SchmittTrigger(self.on)
+        since = t if math.isnan(self.pending_since_s) else self.pending_since_s
+        if t - since >= dwell_s - 1e-9:
+            return SchmittTrigger(not self.on)
+        return SchmittTrigger(self.on, since)
+
+
+_OFF = SchmittTrigger()
+
+
+@dataclass(frozen=True)
+class GuardSignals:
+    """Filtered forces and the triggers the guards read; feet_loaded[k] and
+    each_foot_loaded[k] are phase k+1's exit conditions (off where it has none)."""
+
+    t: float = math.nan  # time of the last update (NaN: none yet)
+    foot_fz_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
+    hand_fx_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
+    hands_pulled: SchmittTrigger = _OFF  # both hands > hand_force_threshold_N
+    feet_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # the feet together
+    each_foot_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # each foot
+    # Both hands together pulled backwards (against the stand-up) by more than
+    # hindering_force_threshold_N.
+    hindered: SchmittTrigger = _OFF
+    # A pull needing more than standing_pull_usage_limit of what the standing robot's
+    # feet can hold (filtered usage; the trigger).
+    pull_usage: float = 0.0
+    beyond_feet: SchmittTrigger = _OFF
+
+    def against(self) -> bool:
+        """A pull the stand-up cannot go on under: hindering, or beyond the feet."""
+        return self.hindered.on or self.beyond_feet.on
+
+
+@dataclass(frozen=True)
+class Measurements:
+    """What the guards read: time, psi, CoM, heel edge, feet and hand forces."""
+
+    t: float
+    psi: float
+    com_W: np.ndarray
+    heel_x: float
+    foot_fz_N: tuple[float, float]  # left, right
+    hand_fx_N: tuple[float, float]  # left, right
+    # The x of the thigh pads' centres (NaN: not measured; a release waiting for the CoM
+    # to pass them never begins).
+    thigh_x: float = math.nan
+    # sensing.standing_pull_usage of the measured pull (0: not measured).
+    pull_usage: float = 0.0
+    # Someone asked for the stand-up (live mode's "Stand up" button): with
+    # trigger 'hands', as good as the pull.
+    stand_up: bool = False
+
+
+def _low_pass(previous: tuple[float, ...], raw: tuple[float, ...], gain: float) -> tuple:
+    return tuple(float(y + gain * (x - y)) for y, x in zip(previous, raw, strict=True))
+
+
+def update_guards(
+    g: GuardSignals, m: Measurements, cfg: StandupConfig, table: PhaseTable
+) -> GuardSignals:
+    """The guards' signals after a measurement: forces filtered (first order, exact for a
+    step held over the update: gain 1 - exp(-dt / tau); the first measurement starts the
+    filters), then the triggers of every phase's exit."""
+    if math.isnan(g.t):
+        feet, hands, usage = tuple(m.foot_fz_N), tuple(m.hand_fx_N), m.pull_usage
+    else:
+        tau = cfg.force_filter_time_constant_s
+        gain = 1.0 if tau <= 0 else 1.0 - math.exp(-max(m.t - g.t, 0.0) / tau)
+        feet = _low_pass(g.foot_fz_N, m.foot_fz_N, gain)
+        hands = _low_pass(g.hand_fx_N, m.hand_fx_N, gain)
+        (usage,) = _low_pass((g.pull_usage,), (m.pull_usage,), gain)
+    off, dwell = cfg.guard_off_ratio, cfg.guard_dwell_s
+
+    def trigger(trigger: SchmittTrigger, value: float, threshold: float | None):
+        if threshold is None:
+            return trigger
+        return trigger.update(value, m.t, threshold, off * threshold, dwell)
+
+    hand_on, back_on = cfg.hand_force_threshold_N, cfg.hindering_force_threshold_N
+    exits = [phase.exit for phase in table]
+    return GuardSignals(
+        t=m.t,
+        foot_fz_N=feet,
+        hand_fx_N=hands,
+        hands_pulled=g.hands_pulled.update(min(hands), m.t, hand_on, off * hand_on, dwell),
+        feet_loaded=tuple(
+            trigger(k, sum(feet), e.feet_force_N) for k, e in zip(g.feet_loaded, exits)
+        ),
+        each_foot_loaded=tuple(
+            trigger(k, min(feet), e.each_foot_force_N) for k, e in zip(g.each_foot_loaded, exits)
+        ),
+        hindered=g.hindered.update(-sum(hands), m.t, back_on, off * back_on, dwell),
+        pull_usage=usage,
+        beyond_feet=g.beyond_feet.update(
+            usage, m.t, cfg.standing_pull_usage_limit, off * cfg.standing_pull_usage_limit, dwell
+        ),
+    )
