@@ -223,6 +223,11 @@ class StandupConfig:
     # forward and up per hand (0.52) stands up at every psi_dot bound; 25 N (0.68) stood
     # up and fell at two of four (docs/design.md, "A pull the feet cannot take"). -.
     standing_pull_usage_limit: float = 0.6
+    # Such a pull first braces the arms: they hold the posture they sat with instead of
+    # reaching out, which brings the hands lower and nearer the feet and shortens the
+    # pull's lever; the stand-up waits only if the pull is beyond the feet braced too,
+    # and the arms reach out again once it eases (docs/design.md, "A strong pull").
+    brace_arms: bool = True
     # After a hindering pull stops, the stand-up waits this long: the pull is over, and
     # the arms it swung back return to their posture first. s.
     resume_after_s: float = 0.5

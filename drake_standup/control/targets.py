@@ -32,6 +32,8 @@ class StateReferences:
     seat_hinged: bool  # the seat leaves the pelvis' pitch about the hip axis free
     lean: bool  # the CoM target leans against the pull (the feet alone carry the robot)
     stance: bool  # the legs' posture, not the CoM height, ends the segment (state 4)
+    # The CoM target's height offset where it leans (the arms braced stand lower), m.
+    com_height_offset_m: float = 0.0
 
 
 @dataclass(slots=True)

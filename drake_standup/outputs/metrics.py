@@ -63,7 +63,8 @@ def standup_metrics(
     reference's height at the end of the run, once its last segment (state 4) has run
     through (None otherwise: the run never set it). Where the controller leans the CoM
     against a pull (signals com_lean_W, a horizontal shift d), the standing height is
-    that of the posture tilted about the feet, sqrt(height^2 - |d|^2).
+    that of the posture tilted about the feet, sqrt(height^2 - |d|^2), lowered by the
+    lean's z where the arms are braced against a strong pull.
     standup_time_s runs from entering state 2 to the first standing sample from which
     the robot stays standing for hold_s (None if never); standing_at_end: standing at
     the last sample. 5 N is the unloading level of issue 12's chatter count: 1.5 % of
@@ -95,6 +96,7 @@ def standup_metrics(
         # height is then that of the tilted posture (the controller's own target).
         lean = signals["com_lean_W"]
         height = np.sqrt(np.maximum(height**2 - lean[:, 0] ** 2 - lean[:, 1] ** 2, 0.0))
+        height = height + lean[:, 2]  # lower with the arms braced against a strong pull
     standing = (np.abs(signals["com_W"][:, 2] - height) <= height_tolerance_m) & unloaded
     metrics["standing_at_end"] = bool(standing[-1])
     # Standing from sample i through t[i] + hold_s: no non-standing sample up to the

@@ -105,6 +105,8 @@ def _station_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarr
         signals["push_force_W"] = logs["push_force_W"]
     if "standing_pull_usage" in logs:  # sensing.standing_pull_usage of the measured pull
         signals["standing_pull_usage"] = logs["standing_pull_usage"][:, 0]
+    if "braced_pull_usage" in logs:  # the same, the standing robot's arms braced
+        signals["braced_pull_usage"] = logs["braced_pull_usage"][:, 0]
     if "hand_velocities_W" in logs:  # [v_left, v_right] where the hands are pulled
         signals["hand_velocities_W"] = logs["hand_velocities_W"]
     if "helper_spent" in logs:  # human.HelperWork's running totals, on the plant's steps
@@ -154,4 +156,6 @@ def _controller_signals(logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         "pull_beyond_feet": held[:, 2] > 0.5,
         "held_back_beyond_feet_s": held[:, 3],
     }
+    if "arms_braced" in logs:  # the arms braced against a pull beyond the reaching feet
+        signals["arms_braced"] = logs["arms_braced"][:, 0] > 0.5
     return signals

@@ -337,3 +337,29 @@ def actuated_joints(plant: MultibodyPlant, instance: ModelInstanceIndex) -> Actu
         q_index=np.array([a.joint().position_start() - first_q for a in actuators]),
         v_index=np.array([a.joint().velocity_start() - first_v for a in actuators]),
     )
+
+
+def arm_joint_names(plant: MultibodyPlant, robot: Robot) -> list[str]:
+    """The arms' joints, from the kinematic tree: those on one hand's path to the root and
+    not on the other's (the torso, which both paths share, is not an arm's), root to hand."""
+
+    def path(task: str) -> list[str]:
+        body, names = robot.frame(plant, task).body(), []
+        while body.index() != plant.world_body().index():
+            joint = plant.GetJointByName(_parent_joint(plant, body), robot.model_instance)
+            if joint.num_velocities() == 1:
+                names.append(joint.name())
+            body = joint.parent_body()
+        return names[::-1]
+
+    left, right = path("l_hand"), path("r_hand")
+    return [n for n in left if n not in right] + [n for n in right if n not in left]
+
+
+def _parent_joint(plant: MultibodyPlant, body) -> str:
+    """The name of the joint whose child is body (a tree: exactly one)."""
+    for index in plant.GetJointIndices(body.model_instance()):
+        joint = plant.get_joint(index)
+        if joint.child_body().index() == body.index():
+            return joint.name()
+    raise ValueError(f"{body.name()}: no joint has it as child")

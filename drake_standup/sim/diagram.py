@@ -34,6 +34,7 @@ STATION_SIGNALS = (
     "com_W",
     "net_actuation",
     "standing_pull_usage",
+    "braced_pull_usage",
     "hand_velocities_W",
 )
 CONTROLLER_SIGNALS = (
@@ -44,6 +45,7 @@ CONTROLLER_SIGNALS = (
     "x_d_W",
     "standup_state",
     "held_back",
+    "arms_braced",
     "segment",
     "entry_times_s",
     "controller_diagnostics",

@@ -231,6 +231,7 @@ class CoMTarget:
             height = com_reference[2]
             com_reference[:2] += lean[:2]
             com_reference[2] = math.sqrt(max(height * height - lean[0] ** 2 - lean[1] ** 2, 0.0))
+            com_reference[2] += lean[2]  # the arms braced stand lower
         pulled = F_hand_W is not None and compliant
         next_compliance = compliance
         if pulled or np.count_nonzero(compliance):
@@ -276,6 +277,8 @@ class CoMTarget:
             target[0] = min(
                 max(target[0], -self._config.lean_max_back_m), self._config.lean_max_forward_m
             )
+        if state.lean:
+            target[2] = state.com_height_offset_m
         # count_nonzero: .any() of a 3-vector costs ~5x more (NaN counts in both).
         if not (np.count_nonzero(target) or np.count_nonzero(lean)):
             return lean

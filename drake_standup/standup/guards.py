@@ -61,7 +61,16 @@ class GuardSignals:
     # A pull needing more than standing_pull_usage_limit of what the standing robot's
     # feet can hold (filtered usage; the trigger).
     pull_usage: float = 0.0
+    # The arms braced (held as seated, hands near the body) while the pull needs more
+    # than standing_pull_usage_limit of the feet's hold with the arms reaching out
+    # (standup.brace_arms); beyond_feet then judges the usage braced (filtered).
+    brace: SchmittTrigger = _OFF
+    braced_usage: float = 0.0
     beyond_feet: SchmittTrigger = _OFF
+
+    def usage(self) -> float:
+        """The filtered usage of the standing feet's hold, in the arms' posture chosen."""
+        return self.braced_usage if self.brace.on else self.pull_usage
 
     def against(self) -> bool:
         """A pull the stand-up cannot go on under: hindering, or beyond the feet."""
@@ -81,8 +90,10 @@ class Measurements:
     # The x of the thigh pads' centres (NaN: not measured; a release waiting for the CoM
     # to pass them never begins).
     thigh_x: float = math.nan
-    # sensing.standing_pull_usage of the measured pull (0: not measured).
+    # sensing.standing_pull_usage of the measured pull (0: not measured), and the same
+    # with the arms braced (NaN: not measured; the arms never brace).
     pull_usage: float = 0.0
+    braced_usage: float = math.nan
     # Someone asked for the stand-up (live mode's "Stand up" button): with
     # trigger 'hands', as good as the pull.
     stand_up: bool = False
@@ -98,15 +109,20 @@ def update_guards(
     """The guards' signals after a measurement: forces filtered (first order, exact for a
     step held over the update: gain 1 - exp(-dt / tau); the first measurement starts the
     filters), then the triggers of every phase's exit."""
+    can_brace = cfg.brace_arms and not math.isnan(m.braced_usage)
+    braced_raw = m.braced_usage if can_brace else 0.0
     if math.isnan(g.t):
-        feet, hands, usage = tuple(m.foot_fz_N), tuple(m.hand_fx_N), m.pull_usage
+        feet, hands = tuple(m.foot_fz_N), tuple(m.hand_fx_N)
+        usage, braced = m.pull_usage, braced_raw
     else:
         tau = cfg.force_filter_time_constant_s
         gain = 1.0 if tau <= 0 else 1.0 - math.exp(-max(m.t - g.t, 0.0) / tau)
         feet = _low_pass(g.foot_fz_N, m.foot_fz_N, gain)
         hands = _low_pass(g.hand_fx_N, m.hand_fx_N, gain)
-        (usage,) = _low_pass((g.pull_usage,), (m.pull_usage,), gain)
+        usage, braced = _low_pass((g.pull_usage, g.braced_usage), (m.pull_usage, braced_raw), gain)
     off, dwell = cfg.guard_off_ratio, cfg.guard_dwell_s
+    limit = cfg.standing_pull_usage_limit
+    brace = g.brace.update(usage, m.t, limit, off * limit, dwell) if can_brace else _OFF
 
     def trigger(trigger: SchmittTrigger, value: float, threshold: float | None):
         if threshold is None:
@@ -128,7 +144,9 @@ def update_guards(
         ),
         hindered=g.hindered.update(-sum(hands), m.t, back_on, off * back_on, dwell),
         pull_usage=usage,
+        brace=brace,
+        braced_usage=braced,
         beyond_feet=g.beyond_feet.update(
-            usage, m.t, cfg.standing_pull_usage_limit, off * cfg.standing_pull_usage_limit, dwell
+            braced if brace.on else usage, m.t, limit, off * limit, dwell
         ),
     )

@@ -18,12 +18,13 @@ estimate (control/model.py), the task references (task_references.py) and the QP
 
 Inputs (a station's outputs of the same names, station.py): robot_state, pad_forces_W,
 seat_pad_normal_forces_N, pads_vertical_force_N, hand_wrenches_W (measured), com_W,
-com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, standing_pull_usage; response (1: the
-response code, config.RESPONSES' index: which of the pull the advancement and the task
-references take, standup/task_references.py); and stand_up (1; > 0.5: start; unconnected:
-never), which only the live helper has.
+com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, standing_pull_usage, braced_pull_usage;
+response (1: the response code, config.RESPONSES' index: which of the pull the advancement
+and the task references take, standup/task_references.py); and stand_up (1; > 0.5: start;
+unconnected: never), which only the live helper has.
 Outputs: actuation; controller_diagnostics (control/controller.py: DIAGNOSTICS); psi,
-psi_dot, alpha; com_reference, x_d_W; standup_state, held_back, segment, entry_times_s;
+psi_dot, alpha; com_reference, x_d_W; standup_state, held_back, arms_braced, segment,
+entry_times_s;
 lean_W; compliance_W (the compliant response's offset and rate); mass_estimate.
 """
 
@@ -38,6 +39,7 @@ from drake_standup.config import Scenario
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
+from drake_standup.robot.icub import arm_joint_names
 from drake_standup.standup.advancement import TrajectoryAdvancement
 from drake_standup.standup.com_path import CoMReferenceGenerator
 from drake_standup.standup.contact_schedule import ContactSchedule
@@ -55,6 +57,7 @@ _WIRES = [
     ("state_machine", "heel_x_W", "", "heel_x_W"),
     ("state_machine", "thigh_x_W", "", "thigh_x_W"),
     ("state_machine", "standing_pull_usage", "", "standing_pull_usage"),
+    ("state_machine", "braced_pull_usage", "", "braced_pull_usage"),
     ("state_machine", "pad_forces_W", "", "pad_forces_W"),
     ("state_machine", "hand_wrenches_W", "", "hand_wrenches_W"),
     ("state_machine", "stand_up", "", "stand_up"),
@@ -92,6 +95,7 @@ _OUTPUTS = {
     "x_d_W": ("com_reference", "x_d_W"),
     "standup_state": ("state_machine", "standup_state"),
     "held_back": ("state_machine", "held_back"),
+    "arms_braced": ("state_machine", "arms_braced"),
     "segment": ("state_machine", "segment"),
     "entry_times_s": ("state_machine", "entry_times_s"),
     "lean_W": ("controller", "lean_W"),
@@ -116,7 +120,15 @@ def make_standup_controller(
     g = -plant.gravity_field().gravity_vector()[2]
     specs = contact_specs(plant, robot, config)
     joints = ControllerJoints.of(plant, robot)
-    schedule = PhaseReferences(table, config, joints.names, joints.q_min, joints.q_max)
+    schedule = PhaseReferences(
+        table,
+        config,
+        joints.names,
+        joints.q_min,
+        joints.q_max,
+        arm_joint_names(plant, robot),
+        station.braced_drop_m,
+    )
     systems = {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()

@@ -31,6 +31,7 @@ class StandupStateMachine(LeafSystem):
     """Periodic (standup.update_period_s) state machine with the mode as abstract state.
 
     Inputs: psi (1), com_W (3), heel_x_W (1), thigh_x_W (1; unconnected: never passed),
+    standing_pull_usage and braced_pull_usage (1 each; unconnected: 0, and never braced),
     pad_forces_W (3 per pad, rows of the soles
     given as sole_rows = (left, right)), hand_wrenches_W (12, payloads.HAND_WRENCHES), and
     stand_up (1; > 0.5: go; unconnected: never), which only the live helper has.
@@ -64,6 +65,7 @@ class StandupStateMachine(LeafSystem):
         self._heel = self.DeclareVectorInputPort("heel_x_W", 1)
         self._thigh = self.DeclareVectorInputPort("thigh_x_W", 1)
         self._usage = self.DeclareVectorInputPort("standing_pull_usage", 1)
+        self._braced_usage = self.DeclareVectorInputPort("braced_pull_usage", 1)
         self._pads = self.DeclareVectorInputPort("pad_forces_W", 3 * n_pads)
         self._hands = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         self._stand_up = self.DeclareVectorInputPort("stand_up", 1)
@@ -79,6 +81,7 @@ class StandupStateMachine(LeafSystem):
             "segment": (SEGMENT.size, self._CalcSegment),
             "entry_times_s": (N_STATES, self._CalcEntryTimes),
             "held_back": (4, self._CalcHeldBack),
+            "arms_braced": (1, self._CalcBraced),
         }
         for name, (size, calc) in vectors.items():
             self.DeclareVectorOutputPort(name, size, calc, prerequisites_of_calc=mode_only)
@@ -108,6 +111,9 @@ class StandupStateMachine(LeafSystem):
             pull_usage=float(self._usage.Eval(context)[0])
             if self._usage.HasValue(context)
             else 0.0,
+            braced_usage=float(self._braced_usage.Eval(context)[0])
+            if self._braced_usage.HasValue(context)
+            else math.nan,
         )
 
     def _Update(self, context: Context, state: State) -> None:
@@ -137,6 +143,9 @@ class StandupStateMachine(LeafSystem):
                 mode.held_beyond_feet_s,
             ]
         )
+
+    def _CalcBraced(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, float(self.mode(context).guards.brace.on))
 
     def _CalcEntryTimes(self, context: Context, output: BasicVector) -> None:
         output.SetFromVector(np.array(self.mode(context).entry_times_s))

@@ -47,7 +47,9 @@ ADVANCEMENT, STIFF, COMPLIANT = (RESPONSES.index(name) for name in RESPONSES)
 
 
 class PhaseReferences:
-    """StateReferences of states 1-4 from the phase table (phases.py)."""
+    """StateReferences of states 1-4 from the phase table (phases.py), the arms reaching as
+    the phases' postures have them or braced (arm_joints hold the first tick's posture,
+    as the robot sat: standup.brace_arms)."""
 
     def __init__(
         self,
@@ -56,27 +58,36 @@ class PhaseReferences:
         joint_names: list[str],
         q_min: np.ndarray,
         q_max: np.ndarray,
+        arm_joints: list[str] = (),
+        braced_drop_m: float = 0.0,
     ):
+        """arm_joints: the joints a brace holds; braced_drop_m: how much lower the CoM
+        stands with the arms braced (the CoM target's offset in the states that lean)."""
         margin = config.posture_limit_margin_rad
         self.q_target_min = q_min + margin
         self.q_target_max = q_max - margin
+        arms = np.isin(joint_names, list(arm_joints))
         self._by_state = {}
         for state, phase in enumerate(table, start=1):
             target = joint_values(joint_names, phase.posture_rad, "posture_rad")
             kp = np.array(phase.com_kp_per_s2)
-            self._by_state[state] = StateReferences(
-                kp,
-                2.0 * config.com_damping_ratio * np.sqrt(kp),
-                np.clip(target, self.q_target_min, self.q_target_max),
-                np.isnan(target),
-                phase.base_pitch_rad,
-                phase.seat_hold == "hinged",
-                phase.lean,
-                phase.stance,
-            )
+            for braced in (False, True):
+                held = np.where(arms, np.nan, target) if braced else target
+                self._by_state[state, braced] = StateReferences(
+                    kp,
+                    2.0 * config.com_damping_ratio * np.sqrt(kp),
+                    np.clip(held, self.q_target_min, self.q_target_max),
+                    np.isnan(held),
+                    phase.base_pitch_rad,
+                    phase.seat_hold == "hinged",
+                    phase.lean,
+                    phase.stance,
+                    -braced_drop_m if braced and phase.lean else 0.0,
+                )
 
-    def __getitem__(self, standup_state: int) -> StateReferences:
-        return self._by_state[standup_state]
+    def __getitem__(self, key: int | tuple[int, bool]) -> StateReferences:
+        """The state's references (key: the state, or (the state, the arms braced))."""
+        return self._by_state[key if isinstance(key, tuple) else (key, False)]
 
 
 class ReferenceGenerator:
@@ -169,6 +180,7 @@ class ReferenceGenerator:
         response: int = ADVANCEMENT,
         compliance: np.ndarray | None = None,
         psi_dot: float = 1.0,
+        braced: bool = False,
     ) -> TaskReferences:
         """com_reference = [x_d, xd_dot, xd_ddot] (9,); F_hand_W = [tau_l, f_l, tau_r, f_r]
         (None: no pull); momentum_integral = int L_ang dt; posture: the posture state
@@ -178,8 +190,8 @@ class ReferenceGenerator:
         error before this tick, m s; response: ADVANCEMENT, STIFF or COMPLIANT (which of
         the pull acts, module docstring); compliance: the admittance's [offset, rate]
         before this tick (None: at rest); psi_dot: the advancement's rate (the posture
-        filter's clock)."""
-        state = self.schedule[standup_state]
+        filter's clock); braced: the arms braced against a strong pull (PhaseReferences)."""
+        state = self.schedule[standup_state, braced]
         tau_hand = None if F_hand_W is None else terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
         com_target, lean, next_compliance = self.com_target.target(
             terms,

@@ -153,6 +153,7 @@ class StandupWholeBodyController(LeafSystem):
             int(round(self._input("response", context)[0])),
             state.get_value(self._compliance),
             self._psi_dot(context),
+            mode.guards.brace.on,
         )
         tick = self.controller.solve(
             terms,

@@ -129,6 +129,7 @@ class RobotSensing(LeafSystem):
         heel_points: dict[str, np.ndarray],
         thigh_points: dict[str, np.ndarray] | None = None,
         standing: StandingSupport | None = None,
+        braced: StandingSupport | None = None,
     ):
         super().__init__()
         self._plant = plant
@@ -141,7 +142,6 @@ class RobotSensing(LeafSystem):
             (plant.GetFrameByName(f, self._instance), np.asarray(p))
             for f, p in (thigh_points or {}).items()
         ]
-        self._standing = standing
         self._hands = [robot.frame(plant, name) for name in TASK_FRAMES]
         self._g = -plant.gravity_field().gravity_vector()[2]
         nx = plant.num_multibody_states(self._instance)
@@ -169,13 +169,14 @@ class RobotSensing(LeafSystem):
         self.DeclareVectorOutputPort(
             "hand_velocities_W", 6, self._CalcHandVelocities, prerequisites_of_calc=state_only
         )
-        if standing is not None:
-            self.DeclareVectorOutputPort(
-                "standing_pull_usage",
-                1,
-                self._CalcUsage,
-                prerequisites_of_calc={self._wrenches.ticket()},
-            )
+        for name, support in (("standing_pull_usage", standing), ("braced_pull_usage", braced)):
+            if support is not None:
+                self.DeclareVectorOutputPort(
+                    name,
+                    1,
+                    self._usage_of(support),
+                    prerequisites_of_calc={self._wrenches.ticket()},
+                )
 
     def _set_plant_state(self, context: Context, check: bool) -> None:
         """The private plant context at robot_state (check: unless it is there
@@ -234,14 +235,17 @@ class RobotSensing(LeafSystem):
             )
         )
 
-    def _CalcUsage(self, context: Context, output: BasicVector) -> None:
-        F = self._wrenches.Eval(context)
-        usage = (
-            standing_pull_usage(F, self._mass_kg * self._g, self._standing)
-            if np.count_nonzero(F)
-            else 0.0
-        )
-        output.SetAtIndex(0, usage)
+    def _usage_of(self, support: StandingSupport):
+        def calc(context: Context, output: BasicVector) -> None:
+            F = self._wrenches.Eval(context)
+            usage = (
+                standing_pull_usage(F, self._mass_kg * self._g, support)
+                if np.count_nonzero(F)
+                else 0.0
+            )
+            output.SetAtIndex(0, usage)
+
+        return calc
 
     def _CalcOmegaF(self, context: Context, output: BasicVector) -> None:
         """Omega f = J_com M^-1 sum_h J_h^T F_h (paper, Sec. II).

@@ -20,6 +20,7 @@ Outputs
     com_W, com_velocity_W, omega_f_W, heel_x_W, thigh_x_W   sensing.py
     hand_positions_W, hand_velocities_W   (6 each) where the hands are pulled, m, m/s
     standing_pull_usage       (1) the share of the standing feet's hold a pull needs
+    braced_pull_usage         (1) the same with the arms braced (held as seated)
     push_force_W              (3) only with perturbation.pushes
 """
 
@@ -35,7 +36,7 @@ from pydrake.systems.primitives import MatrixGain, PassThrough
 from drake_standup.config import Scenario
 from drake_standup.config.phases import SEAT_PAD_ROWS
 from drake_standup.ports.payloads import HAND_WRENCHES
-from drake_standup.robot.icub import ActuatedJoints, Robot, actuated_joints
+from drake_standup.robot.icub import ActuatedJoints, Robot, actuated_joints, arm_joint_names
 from drake_standup.world.pad_forces import ContactForceReporter
 from drake_standup.world.perturbations import NoisyWrenchSensor, PushSource
 from drake_standup.world.scene import (
@@ -69,6 +70,9 @@ class Station:
     pad_groups: dict[str, str]  # pad geometry name -> group, in pad_forces_W's order
     joints: ActuatedJoints
     standing: StandingSupport  # what the standing robot's feet can hold (sensing.py)
+    # ... with its arms braced: held as seated, not reaching out (arm_joint_names).
+    braced: StandingSupport
+    braced_drop_m: float  # how much lower the erect CoM stands with the arms braced
 
     @property
     def plant(self) -> MultibodyPlant:
@@ -103,7 +107,10 @@ def make_station(
     instance = robot.model_instance
     pad_groups, reporter = _add_pad_forces(builder, plant, robot)
     measured = _add_pushes_and_hand_sensors(builder, scenario, plant, robot)
-    standing, robot_state = _add_sensing(builder, scene, scenario, feet, measured)
+    (standing, braced), robot_state = _add_sensing(builder, scene, scenario, feet, measured)
+    drop = erect_com_height_m(scene, scenario, scenario.phases.rise.posture_rad) - (
+        erect_com_height_m(scene, scenario, braced_posture(scene, scenario.phases.rise.posture_rad))
+    )
 
     builder.ExportInput(plant.get_actuation_input_port(instance), "actuation")
     if pd_gains is not None:
@@ -115,7 +122,8 @@ def make_station(
     builder.ExportOutput(reporter.get_output_port(), "pad_forces_W")
     diagram = builder.Build()
     diagram.set_name("station")
-    return Station(diagram, scene, pad_groups, actuated_joints(plant, instance), standing)
+    joints = actuated_joints(plant, instance)
+    return Station(diagram, scene, pad_groups, joints, standing, braced, max(drop, 0.0))
 
 
 def _add_pad_forces(
@@ -177,35 +185,53 @@ def _add_pushes_and_hand_sensors(
     return measured
 
 
+def braced_posture(scene: Scene, posture_rad: dict[str, float]) -> dict[str, float]:
+    """posture_rad with the arms braced: their joints (arm_joint_names) left out, so they
+    stay as the robot sat (scene._standing_context, the controller's posture hold)."""
+    arms = set(arm_joint_names(scene.plant, scene.robot))
+    return {name: value for name, value in posture_rad.items() if name not in arms}
+
+
 def _add_sensing(
     builder: DiagramBuilder,
     scene: Scene,
     scenario: Scenario,
     feet: FeetReach,
     measured: OutputPort,
-) -> tuple[StandingSupport, OutputPort]:
-    """What the robot senses of itself (sensing.py), with what its standing feet can hold;
-    returns that StandingSupport and the robot's state output."""
+) -> tuple[tuple[StandingSupport, StandingSupport], OutputPort]:
+    """What the robot senses of itself (sensing.py), with what its standing feet can hold,
+    its arms reaching as the rise's posture has them or braced; returns those two
+    StandingSupports and the robot's state output."""
     plant, robot = scene.plant, scene.robot
     rise = scenario.phases.rise
-    hands, soles = standing_offsets_m(scene, scenario, rise.posture_rad)
-    standing = StandingSupport(
-        com_height_m=rise.com_height_m or erect_com_height_m(scene, scenario, rise.posture_rad),
-        hands_m=hands,
-        soles_m=soles,
-        lean_m=feet.lean_m,
-        cop_x_m=feet.cop_x_m,
-        cop_y_m=feet.cop_y_m,
-    )
+
+    def support(posture: dict[str, float], height_m: float | None) -> StandingSupport:
+        hands, soles = standing_offsets_m(scene, scenario, posture)
+        return StandingSupport(
+            com_height_m=height_m or erect_com_height_m(scene, scenario, posture),
+            hands_m=hands,
+            soles_m=soles,
+            lean_m=feet.lean_m,
+            cop_x_m=feet.cop_x_m,
+            cop_y_m=feet.cop_y_m,
+        )
+
+    standing = support(rise.posture_rad, rise.com_height_m)
+    braced = support(braced_posture(scene, rise.posture_rad), None)
     sensing = builder.AddNamedSystem(
         "sensing",
-        RobotSensing(plant, robot, heel_points(robot), thigh_points(robot), standing),
+        RobotSensing(plant, robot, heel_points(robot), thigh_points(robot), standing, braced),
     )
     robot_state = plant.get_state_output_port(robot.model_instance)
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
     builder.Connect(measured, sensing.GetInputPort("hand_wrenches_W"))
     for name in ("com_W", "com_velocity_W", "omega_f_W", "heel_x_W", "thigh_x_W"):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
-    for name in ("standing_pull_usage", "hand_positions_W", "hand_velocities_W"):
+    for name in (
+        "standing_pull_usage",
+        "braced_pull_usage",
+        "hand_positions_W",
+        "hand_velocities_W",
+    ):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
-    return standing, robot_state
+    return (standing, braced), robot_state
