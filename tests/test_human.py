@@ -155,6 +155,18 @@ def test_person_follows_a_hand_that_outruns_them():
     )
 
 
+def test_a_person_leading_a_fast_hand_speeds_up_with_it():
+    """At t = 2 s the pace is 0.1 m along u; a hand 0.08 m along u moving at 0.5 m/s
+    along u (seen now): the person leads it by 0.02 m and moves at its speed, not their
+    pace, so only the spring acts, K 0.02 (2 N) along u; the damping about the pace
+    (D (0.1 - 0.5) = -4 N) would have pulled it back."""
+    cfg, v = _person(), 0.5 * U
+    np.testing.assert_allclose(reactive_force(cfg, 2.0, P0 + 0.08 * U, v, P0), 2.0 * U, atol=1e-12)
+    # Slower than the pace, the person still pulls at their pace: D (0.1 - 0.05) more.
+    slow = reactive_force(cfg, 2.0, P0 + 0.08 * U, 0.05 * U, P0)
+    np.testing.assert_allclose(slow, (2.0 + 10.0 * 0.05) * U, atol=1e-12)
+
+
 def test_person_guides_along_u_not_back_to_a_line():
     """A hand at rest 0.1 m sideways of the start, at t = 1.5 s (pace 0.05 m): pulled
     K 0.05 + D 0.1 along u and nothing sideways (the first model pulled it back in y)."""
@@ -414,3 +426,22 @@ def test_person_acts_on_what_they_saw_their_reaction_time_ago():
     np.testing.assert_allclose(late, expected(0.21, p_b, com_b - com_a), atol=1e-12)
     # Not vacuous: what the person saw changes the pull by more than a newton.
     assert np.abs(late - np.array(expected(0.21, p_a, 0.0))).max() > 1.0
+
+
+def test_a_steady_motion_is_tracked_without_the_reaction_times_lag():
+    """A hand moving steadily at 0.5 m/s along u, seen 0.2 s ago: the person carries what
+    they saw on to now (predicted) and pulls exactly as a person who sees it now; a
+    hand that has just stopped where they expect it is pulled on by their damping about
+    the speed they still expect, D v = 10 x 0.5 = 5 N along u."""
+    from drake_standup.world.human import PERCEIVED, predicted
+
+    cfg, v, lag = _person(), 0.5 * U, 0.2
+    now = P0 + 0.3 * U
+    sample = np.zeros(PERCEIVED)
+    sample[3:6], sample[9:12] = now - lag * v, v  # the right hand, 0.2 s ago
+    seen = predicted(sample, 1, lag)
+    np.testing.assert_allclose(seen[0], now, atol=1e-15)
+    at_once = reactive_force(cfg, 3.0, now, v, P0)
+    np.testing.assert_allclose(reactive_force(cfg, 3.0, now, v, P0, seen=seen), at_once)
+    braked = reactive_force(cfg, 3.0, now, np.zeros(3), P0, seen=seen)
+    np.testing.assert_allclose(braked - reactive_force(cfg, 3.0, now, np.zeros(3), P0), 5.0 * U)

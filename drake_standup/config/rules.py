@@ -83,7 +83,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "human.pulls[*].duration_s human.reactive.duration_s human.reactive.force_cap_N "
         "human.reactive.pace_mps advancement.eps advancement.psi_ddot_filter_s "
         "phases.*.segment_psi phases.*.com_height_m standup.update_period_s "
-        "standup.standing_pull_usage_limit "
+        "standup.standing_pull_usage_limit standup.gentle_pull_force_N "
         "controller.momentum_weight controller.*_time_constant_s "
         "controller.joint_limit_horizon_s controller.joint_braking_rad_per_s2 "
         "controller.*friction_coefficient* "
@@ -96,7 +96,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     ),
     (
         NON_NEGATIVE,
-        "human.pulls[*].start_s human.pulls[*].ramp_s "
+        "human.pulls[*].start_s human.pulls[*].ramp_s standup.gentle_pull_time_s "
         "human.reactive.start_s human.reactive.ramp_s human.reactive.stiffness_N_per_m "
         "human.reactive.reaction_time_s "
         "human.reactive.damping_Ns_per_m human.reactive.travel_m "

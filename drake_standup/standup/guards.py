@@ -53,6 +53,8 @@ class GuardSignals:
     foot_fz_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
     hand_fx_N: tuple[float, float] = (0.0, 0.0)  # filtered, left, right
     hands_pulled: SchmittTrigger = _OFF  # both hands > hand_force_threshold_N
+    # both hands > gentle_pull_force_N for gentle_pull_time_s
+    hands_held: SchmittTrigger = _OFF
     feet_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # the feet together
     each_foot_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # each foot
     # Both hands together pulled backwards (against the stand-up) by more than
@@ -130,12 +132,16 @@ def update_guards(
         return trigger.update(value, m.t, threshold, off * threshold, dwell)
 
     hand_on, back_on = cfg.hand_force_threshold_N, cfg.hindering_force_threshold_N
+    gentle = cfg.gentle_pull_force_N
     exits = [phase.exit for phase in table]
     return GuardSignals(
         t=m.t,
         foot_fz_N=feet,
         hand_fx_N=hands,
         hands_pulled=g.hands_pulled.update(min(hands), m.t, hand_on, off * hand_on, dwell),
+        hands_held=g.hands_held.update(
+            min(hands), m.t, gentle, off * gentle, max(dwell, cfg.gentle_pull_time_s)
+        ),
         feet_loaded=tuple(
             trigger(k, sum(feet), e.feet_force_N) for k, e in zip(g.feet_loaded, exits)
         ),

@@ -183,7 +183,8 @@ def guard_holds(phase: Phase, mode: StandupMode, m: Measurements, cfg: StandupCo
     g = mode.guards
     if dwell < guard.min_time_s:
         return False
-    if guard.asked and not (cfg.trigger == "time" or g.hands_pulled.on or m.stand_up):
+    pulled = g.hands_pulled.on or g.hands_held.on
+    if guard.asked and not (cfg.trigger == "time" or pulled or m.stand_up):
         return False
     if guard.segment_done and not (
         m.psi - mode.psi_entry >= mode.segment_psi or not any(mode.delta_m)

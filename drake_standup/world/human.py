@@ -3,7 +3,8 @@
 Two humans: 'scripted' applies the scenario's pulls (trapezoids in time, each
 on one hand, constant world direction); 'reactive' is a person guiding each hand
 (partner.py: the velocity and the path guide), who acts on what they saw of the
-robot reaction_time_s ago (this system keeps it) through their arm's impedance.
+robot reaction_time_s ago (this system keeps it), carried on at the velocity they saw
+(predicted), through their arm's impedance.
 The wrench acts at the origin of the hand task frame (the hand's DH frame).
 """
 
@@ -70,6 +71,15 @@ def scripted_forces(pulls: list[Pull], t: float) -> np.ndarray:
         scale = trapezoid(t, pull.start_s, pull.duration_s, pull.ramp_s)
         forces[HANDS[pull.hand]] += scale * np.asarray(pull.force_N)
     return forces
+
+
+def predicted(sample: np.ndarray, hand: int, lag_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """(position, velocity) of hand (0 left, 1 right) a person expects now from a sample
+    (PERCEIVED) seen lag_s ago: carried on at the velocity seen. People track a steady
+    motion without their reaction time's lag and lag its changes (SPEC 10); a person
+    without it drags a hand moving at v back by K v lag_s (15 N at 0.5 m/s, 0.2 s)."""
+    p, v = sample[3 * hand : 3 * hand + 3], sample[6 + 3 * hand : 9 + 3 * hand]
+    return p + lag_s * v, v
 
 
 class HumanWrenchSource(LeafSystem):
@@ -179,9 +189,9 @@ class HumanWrenchSource(LeafSystem):
         if not r.start_s < t < r.start_s + r.duration_s:
             return np.zeros((2, 3))  # no kinematics needed outside the pull
         p, v = self._hands(context)
-        if self._slots:  # what the person saw reaction_time_s ago
+        if self._slots:  # what the person saw reaction_time_s ago, carried on to now
             oldest = context.get_discrete_state(self._seen_index).value()[:PERCEIVED]
-            seen = [(oldest[3 * i : 3 * i + 3], oldest[6 + 3 * i : 9 + 3 * i]) for i in range(2)]
+            seen = [predicted(oldest, i, self._slots * PERCEPTION_PERIOD_S) for i in range(2)]
             rise = oldest[12] - captured[6]
         else:
             seen, rise = [None, None], self._com_height() - captured[6]

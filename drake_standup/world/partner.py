@@ -52,7 +52,9 @@ def reactive_force(
     so a hand that outruns them, or swings across u, is followed, not pulled back to a
     line in space; their arm's impedance acts on the hand now:
         F = K (target - p_hand) + D (v_target - v_hand),
-    v_target the target's velocity. Faded by eased (they let go once the robot is up).
+    v_target the target's velocity: the hand's as seen, at least the pace along u (a
+    person leading a hand that moves faster than their pace follows its speed: the
+    pace follows the robot's rise). Faded by eased (they let go once the robot is up).
     """
     scale = eased(cfg, t, com_rise_m)
     if scale == 0.0:
@@ -65,10 +67,10 @@ def reactive_force(
     s_pace = min(walked, cfg.travel_m)
     ahead = s_pace - float((p_seen - p_start) @ u)
     target, v_target = p_seen, v_seen
-    if ahead > 0.0:  # the person leads the hand along u
+    if ahead > 0.0:  # the person leads the hand along u, never slower than they see it go
         pacing = speed if walked < cfg.travel_m else 0.0
         target = p_seen + ahead * u
-        v_target = v_seen + (pacing - float(v_seen @ u)) * u
+        v_target = v_seen + max(pacing - float(v_seen @ u), 0.0) * u
     f = cfg.stiffness_N_per_m * (target - p_hand) + cfg.damping_Ns_per_m * (v_target - v_hand)
     norm = np.linalg.norm(f)
     if norm > cfg.force_cap_N:
