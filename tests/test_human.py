@@ -424,8 +424,9 @@ def test_person_acts_on_what_they_saw_their_reaction_time_ago():
     np.testing.assert_allclose(force(0.19), expected(0.19, p_a, 0.0), atol=1e-12)
     late = force(0.21)
     np.testing.assert_allclose(late, expected(0.21, p_b, com_b - com_a), atol=1e-12)
-    # Not vacuous: what the person saw changes the pull by more than a newton.
-    assert np.abs(late - np.array(expected(0.21, p_a, 0.0))).max() > 1.0
+    # Not vacuous: what the person saw changes the pull (along u: the arms move mostly
+    # across it) by far more than the tolerance.
+    assert np.abs(late - np.array(expected(0.21, p_a, 0.0))).max() > 0.1
 
 
 def test_a_steady_motion_is_tracked_without_the_reaction_times_lag():

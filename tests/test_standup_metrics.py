@@ -9,6 +9,7 @@ from drake_standup.outputs.metrics import (
     helper_metrics,
     path_deviation_max_m,
     seated_rest_metrics,
+    sit_backs,
     smoothness_metrics,
     standup_metrics,
 )
@@ -300,3 +301,9 @@ def test_seated_rest_measures_the_slide_and_the_drop_before_the_standup_only():
     # The 0.3 m move at 1 s lies inside the 3 s window.
     assert never["seated_slide_m"] == pytest.approx(np.hypot(0.303, 0.004))
     assert never["seated_normal_force_N"]["thighs"] == 0.0
+
+
+def test_sit_backs_count_the_returns_to_state_1():
+    """State 1 again after 2 or 3 counts; staying in 1, and a step back from 3 to 2, do not."""
+    assert sit_backs(np.array([1, 1, 2, 2, 1, 1, 2, 3, 2, 3, 1, 2, 3, 4])) == 2
+    assert sit_backs(np.array([1, 1, 1])) == 0

@@ -239,6 +239,13 @@ def smoothness_metrics(
     return metrics
 
 
+def sit_backs(state: np.ndarray) -> int:
+    """How often the stand-up went back to state 1 once it had left it (a pull against
+    it sat it back), from the state's samples."""
+    state = np.asarray(state)
+    return int(np.count_nonzero((state[1:] == 1) & (state[:-1] > 1)))
+
+
 def run_metrics(
     signals: dict[str, np.ndarray],
     station,
@@ -286,6 +293,9 @@ def run_metrics(
         metrics["held_back_s"] = float(signals["held_back_s"][-1])
         if "held_back_beyond_feet_s" in signals:  # signals.npz before issue 21 lack it
             metrics["held_back_beyond_feet_s"] = float(signals["held_back_beyond_feet_s"][-1])
+        metrics["sit_backs"] = sit_backs(signals["state"])
+        if "arms_braced" in signals:  # how long the arms were braced against a pull
+            metrics["arms_braced_s"] = float(np.count_nonzero(signals["arms_braced"]) * step)
     if samples and "helper_work_J" in signals:  # the plant's steps' totals (HelperWork)
         metrics.update({name: float(signals[name][-1]) for name in HELPER_SPENT})
     elif "hand_velocities_W" in signals:  # the logged samples only

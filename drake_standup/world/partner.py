@@ -50,8 +50,9 @@ def reactive_force(
     the hand from where they saw it (seen: its position and velocity reaction_time_s
     ago; None: now) to that progress: the target is p_seen + max(s_pace - s_seen, 0) u,
     so a hand that outruns them, or swings across u, is followed, not pulled back to a
-    line in space; their arm's impedance acts on the hand now:
-        F = K (target - p_hand) + D (v_target - v_hand),
+    line in space; their arm's impedance acts on the hand now, along u (across it their
+    arm yields):
+        F = [(K (target - p_hand) + D (v_target - v_hand)) . u] u,
     v_target the target's velocity: the hand's as seen, at least the pace along u (a
     person leading a hand that moves faster than their pace follows its speed: the
     pace follows the robot's rise). Faded by eased (they let go once the robot is up).
@@ -71,7 +72,10 @@ def reactive_force(
         pacing = speed if walked < cfg.travel_m else 0.0
         target = p_seen + ahead * u
         v_target = v_seen + max(pacing - float(v_seen @ u), 0.0) * u
-    f = cfg.stiffness_N_per_m * (target - p_hand) + cfg.damping_Ns_per_m * (v_target - v_hand)
+    # Along u only: across it the person's arm yields (a spring there, to where they saw
+    # the hand 0.2 s ago, rang the robot's light arms sideways at +-13 N; measured).
+    along = cfg.stiffness_N_per_m * (target - p_hand) + cfg.damping_Ns_per_m * (v_target - v_hand)
+    f = float(along @ u) * u
     norm = np.linalg.norm(f)
     if norm > cfg.force_cap_N:
         f *= cfg.force_cap_N / norm
