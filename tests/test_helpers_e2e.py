@@ -123,13 +123,22 @@ def test_the_qp_plans_what_the_plant_does_while_the_robot_leaves_the_seat():
     assert np.median(errors) <= 0.3, np.round(errors, 2)
 
 
-def test_a_pull_beyond_the_standing_feet_waits_and_says_so():
+def test_a_pull_beyond_the_reaching_feet_braces_the_arms_and_stands_up():
     """25 N forward and 25 N up per hand held from 3 s (the assistance sweep's largest
-    pull) stood the robot up into a pull its feet could not hold, and it fell at bounds
-    2.5 and 4. Now it waits seated while that pull lasts, says why, and stands up once the
-    helper lets go (at 8 s)."""
+    pull) needs more of the standing feet's hold than the limit with the arms reaching
+    out. Braced (standup.brace_arms: the arms held as seated, a shorter lever) it stands
+    up under the pull, state 4 before the pull ends at 8 s, erect once the arms reach out
+    again. With the brace off it waits seated while the pull lasts, says why, and stands
+    up once the helper lets go (issue 21's answer; standing up into it fell at psi_dot
+    bounds 2.5 and 4)."""
     pull = [25.0, 0.0, 25.0]
     scenario = _pulled(pull, pull, 3.0, 0.5, duration_s=5.0, name="assisted")
+    m = simulate(scenario, None, record=False, progress=False).metrics
+    _stands_erect(m)
+    assert m["state_entry_times_s"][3] < 8.0
+    assert m["arms_braced_s"] > 2.0 and m["held_back_beyond_feet_s"] == 0.0
+    assert m["sit_backs"] == 0
+    scenario.standup.brace_arms = False
     m = simulate(scenario, None, record=False, progress=False).metrics
     _stands_erect(m)
     assert m["held_back_beyond_feet_s"] > 4.0
