@@ -346,7 +346,7 @@ def arm_joint_names(plant: MultibodyPlant, robot: Robot) -> list[str]:
     def path(task: str) -> list[str]:
         body, names = robot.frame(plant, task).body(), []
         while body.index() != plant.world_body().index():
-            joint = plant.GetJointByName(_parent_joint(plant, body), robot.model_instance)
+            joint = _parent_joint(plant, body)
             if joint.num_velocities() == 1:
                 names.append(joint.name())
             body = joint.parent_body()
@@ -356,10 +356,10 @@ def arm_joint_names(plant: MultibodyPlant, robot: Robot) -> list[str]:
     return [n for n in left if n not in right] + [n for n in right if n not in left]
 
 
-def _parent_joint(plant: MultibodyPlant, body) -> str:
-    """The name of the joint whose child is body (a tree: exactly one)."""
+def _parent_joint(plant: MultibodyPlant, body):
+    """The joint whose child is body (a tree: exactly one)."""
     for index in plant.GetJointIndices(body.model_instance()):
         joint = plant.get_joint(index)
         if joint.child_body().index() == body.index():
-            return joint.name()
+            return joint
     raise ValueError(f"{body.name()}: no joint has it as child")

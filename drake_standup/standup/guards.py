@@ -70,10 +70,6 @@ class GuardSignals:
     braced_usage: float = 0.0
     beyond_feet: SchmittTrigger = _OFF
 
-    def usage(self) -> float:
-        """The filtered usage of the standing feet's hold, in the arms' posture chosen."""
-        return self.braced_usage if self.brace.on else self.pull_usage
-
     def against(self) -> bool:
         """A pull the stand-up cannot go on under: hindering, or beyond the feet."""
         return self.hindered.on or self.beyond_feet.on

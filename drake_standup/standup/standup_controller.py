@@ -39,7 +39,6 @@ from drake_standup.config import Scenario
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
-from drake_standup.robot.icub import arm_joint_names
 from drake_standup.standup.advancement import TrajectoryAdvancement
 from drake_standup.standup.com_path import CoMReferenceGenerator
 from drake_standup.standup.contact_schedule import ContactSchedule
@@ -126,7 +125,7 @@ def make_standup_controller(
         joints.names,
         joints.q_min,
         joints.q_max,
-        arm_joint_names(plant, robot),
+        station.arm_joints,
         station.braced_drop_m,
     )
     systems = {

@@ -73,6 +73,7 @@ class Station:
     # ... with its arms braced: held as seated, not reaching out (arm_joint_names).
     braced: StandingSupport
     braced_drop_m: float  # how much lower the erect CoM stands with the arms braced
+    arm_joints: list[str]  # the joints a brace holds (arm_joint_names)
 
     @property
     def plant(self) -> MultibodyPlant:
@@ -107,9 +108,10 @@ def make_station(
     instance = robot.model_instance
     pad_groups, reporter = _add_pad_forces(builder, plant, robot)
     measured = _add_pushes_and_hand_sensors(builder, scenario, plant, robot)
-    (standing, braced), robot_state = _add_sensing(builder, scene, scenario, feet, measured)
+    arms = arm_joint_names(plant, robot)
+    (standing, braced), robot_state = _add_sensing(builder, scene, scenario, feet, measured, arms)
     drop = erect_com_height_m(scene, scenario, scenario.phases.rise.posture_rad) - (
-        erect_com_height_m(scene, scenario, braced_posture(scene, scenario.phases.rise.posture_rad))
+        braced.com_height_m
     )
 
     builder.ExportInput(plant.get_actuation_input_port(instance), "actuation")
@@ -123,7 +125,7 @@ def make_station(
     diagram = builder.Build()
     diagram.set_name("station")
     joints = actuated_joints(plant, instance)
-    return Station(diagram, scene, pad_groups, joints, standing, braced, max(drop, 0.0))
+    return Station(diagram, scene, pad_groups, joints, standing, braced, max(drop, 0.0), arms)
 
 
 def _add_pad_forces(
@@ -185,11 +187,10 @@ def _add_pushes_and_hand_sensors(
     return measured
 
 
-def braced_posture(scene: Scene, posture_rad: dict[str, float]) -> dict[str, float]:
+def braced_posture(posture_rad: dict[str, float], arm_joints: list[str]) -> dict[str, float]:
     """posture_rad with the arms braced: their joints (arm_joint_names) left out, so they
     stay as the robot sat (scene._standing_context, the controller's posture hold)."""
-    arms = set(arm_joint_names(scene.plant, scene.robot))
-    return {name: value for name, value in posture_rad.items() if name not in arms}
+    return {name: value for name, value in posture_rad.items() if name not in arm_joints}
 
 
 def _add_sensing(
@@ -198,10 +199,11 @@ def _add_sensing(
     scenario: Scenario,
     feet: FeetReach,
     measured: OutputPort,
+    arm_joints: list[str],
 ) -> tuple[tuple[StandingSupport, StandingSupport], OutputPort]:
     """What the robot senses of itself (sensing.py), with what its standing feet can hold,
-    its arms reaching as the rise's posture has them or braced; returns those two
-    StandingSupports and the robot's state output."""
+    its arms reaching as the rise's posture has them or braced (arm_joints held as
+    seated); returns those two StandingSupports and the robot's state output."""
     plant, robot = scene.plant, scene.robot
     rise = scenario.phases.rise
 
@@ -217,7 +219,7 @@ def _add_sensing(
         )
 
     standing = support(rise.posture_rad, rise.com_height_m)
-    braced = support(braced_posture(scene, rise.posture_rad), None)
+    braced = support(braced_posture(rise.posture_rad, arm_joints), None)
     sensing = builder.AddNamedSystem(
         "sensing",
         RobotSensing(plant, robot, heel_points(robot), thigh_points(robot), standing, braced),
