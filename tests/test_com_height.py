@@ -154,6 +154,12 @@ def test_state_3_starts_where_the_following_state_2_left_the_reference(start_at_
     assert abs(before[2] - end[2]) == pytest.approx(0.05)
 
 
+def _against(m):
+    """m under a pull the feet could not hold: it moves the CoP back to the heels, 1 m
+    behind here (_m)."""
+    return dataclasses.replace(m, cop_shift_m=-(m.com_W[0] - m.heel_x))
+
+
 def test_a_sit_back_starts_from_the_reference_actually_used():
     """A backward pull mid-way through the following state 2: state 1's return starts at
     the reference used then (the path's x, y; the CoM's height, not the path's) and ends
@@ -166,9 +172,8 @@ def test_a_sit_back_starts_from_the_reference_actually_used():
     before = _used(mode, psi, com)
     x = _min_jerk_position(mode.x_start_m, mode.delta_m, table.forward.segment_psi, 3.0, psi)
     np.testing.assert_allclose(before, [x[0], x[1], com[2]], atol=1e-12)
-    new = next_mode(
-        _settled(mode, _m(t, psi, com, hands=back), table), _m(t, psi, com, hands=back), CFG, table
-    )
+    m = _against(_m(t, psi, com, hands=back))
+    new = next_mode(_settled(mode, m, table), m, CFG, table)
     assert new.state == 1 and not new.height_follows
     np.testing.assert_allclose(new.x_start_m, before, atol=1e-12)
     np.testing.assert_allclose(_used(new, psi, com), before, atol=1e-12)
@@ -192,7 +197,7 @@ def test_a_step_back_holds_the_reference_used():
     before = _used(mode, psi, com)
     x = _min_jerk_position(mode.x_start_m, mode.delta_m, table.lift_off.segment_psi, 5.0, psi)
     np.testing.assert_allclose(before, x, atol=1e-12)
-    m = _m(t, psi, com, hands=back)
+    m = _against(_m(t, psi, com, hands=back))
     held = next_mode(_settled(mode, m, table), m, CFG, table)
     assert held.state == 2 and not held.height_follows
     np.testing.assert_allclose(_used(held, psi, com), before, atol=1e-12)
@@ -207,7 +212,7 @@ def test_entered_again_after_a_step_back_it_starts_where_the_hold_was():
     mode = _enter(mode, 3, _m(5.0, 5.0, [0.2, 0.0, 0.33]), table)
     t = psi = 5.0 + 0.5 * table.lift_off.unload_s
     back = (-10.0, -10.0)
-    m = _m(t, psi, [0.21, 0.0, 0.325], hands=back)
+    m = _against(_m(t, psi, [0.21, 0.0, 0.325], hands=back))
     held = next_mode(_settled(mode, m, table), m, CFG, table)
     assert held.state == 2
     x_held = _used(held, psi, m.com_W)

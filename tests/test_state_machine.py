@@ -13,6 +13,7 @@ from pydrake.systems.analysis import Simulator
 
 from drake_standup.config import StandupConfig
 from drake_standup.config.phases import PhaseTable
+from drake_standup.standup.guards import heel_usage
 from drake_standup.standup.state_machine import StandupStateMachine
 from drake_standup.standup.transitions import (
     GuardSignals,
@@ -28,6 +29,7 @@ from drake_standup.standup.transitions import (
 )
 
 CFG = StandupConfig()
+CFG_TIME = dataclasses.replace(CFG, trigger="time")
 
 
 def _table(**exits) -> PhaseTable:
@@ -383,17 +385,82 @@ def test_state_3_starts_at_the_com_height():
 
 # --- Issue 13: a pull against the stand-up holds it ------------------------------------
 
-BACK = CFG.hindering_force_threshold_N  # both hands together, backwards
+LIMIT = CFG.standing_pull_usage_limit
+# The CoM's lead over the heels with which the phases hand the robot to its feet.
+LEAD = max(p.exit.com_ahead_of_heels_m or 0.0 for p in TABLE)
 
 
-def test_a_backward_pull_keeps_the_robot_seated():
+def _reach(m: Measurements) -> float:
+    return max(m.com_W[0] - m.heel_x, LEAD)
+
+
+def _pulled(m: Measurements, usage: float, hands=(-10.0, -10.0)) -> Measurements:
+    """m under a backward pull that needs `usage` of the CoM's reach back over the heels."""
+    return dataclasses.replace(m, hand_fx_N=hands, cop_shift_m=-usage * _reach(m))
+
+
+def _back(t, usage=1.5 * LIMIT, **kwargs) -> Measurements:
+    """A pull against the stand-up at t: 1.5 times what the feet may be asked."""
+    return _pulled(_m(t, **kwargs), usage)
+
+
+def test_heel_usage_is_the_share_of_the_reach_back_over_the_heels():
+    """Behind the heels' lead the reach is the phases' lead (the seat holds the pull until
+    the feet take the robot with that lead); further ahead, the CoM's own lead."""
+    seated = dataclasses.replace(_m(3.0, com=COM0, heel_x=0.2), cop_shift_m=-0.012)
+    assert heel_usage(seated, TABLE) == pytest.approx(0.012 / LEAD)
+    ahead = dataclasses.replace(_m(3.0, com=AHEAD, heel_x=0.1), cop_shift_m=-0.05)
+    assert heel_usage(ahead, TABLE) == pytest.approx(0.05 / 0.2)
+    forward = dataclasses.replace(ahead, cop_shift_m=0.05)  # toward the toes: not this
+    assert heel_usage(forward, TABLE) == 0.0
+    lifted = dataclasses.replace(ahead, cop_shift_m=-math.inf)
+    assert heel_usage(lifted, TABLE) == 10.0
+
+
+def test_a_pull_the_feet_could_not_hold_keeps_the_robot_seated():
+    """Judged by its effect: seated, a backward pull that would need more than the limit
+    of the reach over the heels waits; one that needs less starts, however hard the
+    hands are pulled back."""
     cfg = dataclasses.replace(CFG, trigger="time")
     mode = initial_mode(COM0)
-    back = (-(BACK / 2 + 1.0), -(BACK / 2 + 1.0))
+    seated = _m(3.5, com=COM0, heel_x=0.2)
+    assert _next(mode, _pulled(seated, 1.05 * LIMIT), cfg).state == 1
+    assert _next(mode, _pulled(seated, 0.95 * LIMIT, hands=(-30.0, -30.0)), cfg).state == 2
+
+
+def test_a_pull_that_sat_the_robot_back_holds_it_until_it_eases():
+    """A backward pull too much for the feet in state 2 sits the robot back; seated, the
+    same pull needs less of the reach (its lever shorter), but it is still the pull that
+    was against the stand-up: the robot waits until the backward force falls below
+    guard_off_ratio of the largest it felt while hindered, then resume_after_s."""
+    cfg = CFG_TIME
+    mode = _in_state(2, 3.0)
+    sat = _next(mode, _back(3.2, psi=3.2), cfg)  # 2 x 10 N back, 1.5 x the limit
+    assert sat.state == 1 and sat.guards.hindering_back_N == pytest.approx(20.0)
+    seated = _pulled(_m(8.0, com=COM0, heel_x=0.2), 0.3 * LIMIT)  # the same force seated
+    t, mode = 8.0, sat
+    for k in range(100):  # a second of it: still waiting
+        t = 8.0 + 0.01 * k
+        mode = next_mode(mode, dataclasses.replace(seated, t=t, psi=t), cfg, TABLE)
+    assert mode.state == 1 and mode.guards.against()
+    eased = _pulled(seated, 0.1 * LIMIT, hands=(-0.3 * 10.0, -0.3 * 10.0))
+    for k in range(1, 100):  # the pull eased to 30 %: calm, then the stand-up goes on
+        t = 9.0 + 0.01 * k
+        mode = next_mode(mode, dataclasses.replace(eased, t=t, psi=t + 10.0), cfg, TABLE)
+    assert mode.guards.hindering_back_N == 0.0 and mode.state == 2
+
+
+def test_a_backward_force_counts_where_a_scenario_sets_its_threshold():
+    """Older files set standup.hindering_force_threshold_N: both hands together pulled
+    back by more than it hold the stand-up too, whatever the pull's effect."""
+    back_N = 2.5
+    cfg = dataclasses.replace(CFG, trigger="time", hindering_force_threshold_N=back_N)
+    mode = initial_mode(COM0)
+    back = (-(back_N / 2 + 1.0), -(back_N / 2 + 1.0))
     assert _next(mode, _m(3.5, hands=back), cfg).state == 1
-    # Just below the threshold it does not count as hindering.
-    weak = (-(BACK / 2 - 0.5), -(BACK / 2 - 0.5))
+    weak = (-(back_N / 2 - 0.5), -(back_N / 2 - 0.5))
     assert _next(mode, _m(3.5, hands=weak), cfg).state == 2
+    assert _next(mode, _m(3.5, hands=back), CFG_TIME).state == 2  # the default: by effect
 
 
 @pytest.mark.parametrize("state", [2, 3])
@@ -409,7 +476,7 @@ def test_a_backward_pull_with_the_thighs_on_the_chair_sits_back_without_a_jump(s
     assert mode.x_seated_m == tuple(COM0)
     # A tenth into the thighs' release: they carry 97 % of their load (smoothstep).
     t = psi = 3.0 + 0.1 * min(LIFT_OFF.unload_s, mode.segment_psi)
-    new = _next(mode, _m(t, psi=psi, hands=(-10.0, -10.0)), cfg)
+    new = _next(mode, _back(t, psi=psi), cfg)
     assert new.state == 1 and new.entry_times_s[0] == t
     assert all(math.isnan(e) for e in new.entry_times_s[1:])
     tau = (psi - mode.psi_entry) / mode.segment_psi
@@ -440,9 +507,8 @@ def test_state_3_goes_back_onto_the_thighs_while_they_unload(into_release):
     mode = _in_state(3, 5.0)
     end = mode.segment_end()
     t = psi = 5.0 + into_release * LIFT_OFF.unload_s
-    back = (-10.0, -10.0)
     feet = (500.0, 500.0)
-    held = _next(mode, _m(t, psi=psi, feet=feet, hands=back), cfg)
+    held = _next(mode, _back(t, psi=psi, feet=feet), cfg)
     assert held.state == 2 and math.isnan(held.entry_times_s[2])
     tau = min((psi - mode.psi_entry) / mode.segment_psi, 1.0)
     s = 10 * tau**3 - 15 * tau**4 + 6 * tau**5
@@ -451,7 +517,7 @@ def test_state_3_goes_back_onto_the_thighs_while_they_unload(into_release):
     assert held.delta_m == (0.0, 0.0, 0.0)
     assert math.isnan(seat_loads(held, t, TABLE)[1])  # the thighs seated again
     later = t + 5.0  # still pulled: feet loaded, CoM ahead, segment done; still state 2
-    assert _next(held, _m(later, psi=later, feet=feet, hands=back), cfg).state == 2
+    assert _next(held, _back(later, psi=later, feet=feet), cfg).state == 2
     held = dataclasses.replace(held, hindered_until_s=later)
     calm = (0.0, 0.0)
     soon = later + 0.9 * cfg.resume_after_s
@@ -469,9 +535,9 @@ def test_state_3_holds_once_the_thighs_are_off_the_chair():
     mode = _in_state(3, 5.0)
     t = 5.0 + 1.01 * LIFT_OFF.unload_s
     feet = (500.0, 500.0)
-    held = _next(mode, _m(t, feet=feet, hands=(-10.0, -10.0)), cfg)
+    held = _next(mode, _back(t, feet=feet), cfg)
     assert held.state == 3 and held.x_start_m == mode.x_start_m
-    assert _next(held, _m(t + 0.1, feet=feet, hands=(-10.0, -10.0)), cfg).state == 3
+    assert _next(held, _back(t + 0.1, feet=feet), cfg).state == 3
 
 
 def test_the_stand_up_resumes_only_a_while_after_the_pull_stops():
@@ -498,16 +564,17 @@ def test_time_held_back_accumulates_while_hindered():
     cfg = dataclasses.replace(CFG, trigger="time")
     mode = initial_mode(COM0)
     t = 0.0
+    usage = 2.0 * LIMIT
     for k in range(400):  # 4 s of updates every 10 ms: pulled back from 1 to 3 s
         t = 0.01 * k
-        hands = (-10.0, -10.0) if 1.0 <= t < 3.0 else (0.0, 0.0)
-        mode = next_mode(mode, _m(t, hands=hands, com=COM0), cfg, TABLE)
-    # On once the filtered 20 N (first order, tau) crosses the threshold and the dwell
-    # has passed, off likewise once it decays below guard_off_ratio of it: the 2 s
-    # shifted by the difference of the two delays (within an update, 10 ms).
+        m = _m(t, hands=(0.0, 0.0), com=COM0)
+        mode = next_mode(mode, _pulled(m, usage) if 1.0 <= t < 3.0 else m, cfg, TABLE)
+    # On once the filtered usage (first order, tau) crosses the limit and the dwell has
+    # passed, off likewise once it decays below guard_off_ratio of it: the 2 s shifted
+    # by the difference of the two delays (within an update, 10 ms).
     tau, dwell = cfg.force_filter_time_constant_s, cfg.guard_dwell_s
-    on = tau * math.log(20.0 / (20.0 - cfg.hindering_force_threshold_N)) + dwell
-    off = tau * math.log(20.0 / (cfg.guard_off_ratio * cfg.hindering_force_threshold_N)) + dwell
+    on = tau * math.log(usage / (usage - LIMIT)) + dwell
+    off = tau * math.log(usage / (cfg.guard_off_ratio * LIMIT)) + dwell
     assert mode.held_back_s == pytest.approx(2.0 + off - on, abs=0.02)
     assert not mode.guards.hindered.on
 
@@ -551,4 +618,4 @@ def test_stand_up_request_starts_like_the_pull_after_the_balance_time():
     assert _next(mode, asked).state == 2
     assert _next(mode, dataclasses.replace(asked, t=t - 0.1)).state == 1
     assert _next(mode, dataclasses.replace(asked, stand_up=False)).state == 1
-    assert _next(mode, dataclasses.replace(asked, hand_fx_N=(-10.0, -10.0))).state == 1
+    assert _next(mode, _pulled(asked, 1.5 * LIMIT)).state == 1

@@ -1,12 +1,13 @@
-"""What the standing robot's feet can hold (sensing.standing_pull_usage), against a
-moment balance written out here."""
+"""What the standing robot's feet can hold (sensing.standing_pull_usage), and how far a
+pull moves the centre of pressure under the robot now (sensing.pull_cop_shift_m), against
+moment balances written out here."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from drake_standup.world.sensing import StandingSupport, standing_pull_usage
+from drake_standup.world.sensing import StandingSupport, pull_cop_shift_m, standing_pull_usage
 
 WEIGHT_N = 324.0
 SUPPORT = StandingSupport(
@@ -79,3 +80,48 @@ def test_the_opposing_person_and_a_sideways_pull():
 def test_a_pull_that_lifts_the_robot_is_beyond_the_feet():
     up = np.array([0.0, 0.0, WEIGHT_N / 2 + 1.0])
     assert _usage(up, up) == 10.0
+
+
+def _moment_y_about(p_x, ground_z, com, hands, F, weight_N):
+    """The y moment about the ground point (p_x, *, ground_z) of the weight at the CoM and
+    the hands' wrenches (3-D cross products)."""
+    p = np.array([p_x, 0.0, ground_z])
+    total = np.cross(com - p, [0.0, 0.0, -weight_N])
+    for h in range(2):
+        total = total + np.cross(hands[h] - p, F[h, 3:]) + F[h, :3]
+    return total[1]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_pull_moves_the_cop_to_where_the_moments_balance(seed):
+    """The CoP is the ground point about which the weight, the hands' wrenches and the
+    ground's reaction (acting there) have no y moment: found by the linear root of the
+    moment written with 3-D cross products; the shift is its x from the CoM's."""
+    rng = np.random.default_rng(seed)
+    com = np.array([0.15, 0.0, 0.35]) + rng.uniform(-0.05, 0.05, 3)
+    hands = np.array([[0.3, 0.12, 0.4], [0.3, -0.12, 0.4]]) + rng.uniform(-0.1, 0.1, (2, 3))
+    F = np.hstack([rng.uniform(-1, 1, (2, 3)), rng.uniform(-25, 25, (2, 3))])
+    ground_z = 0.011
+    m0, m1 = (_moment_y_about(x, ground_z, com, hands, F, WEIGHT_N) for x in (0.0, 1.0))
+    cop_x = -m0 / (m1 - m0)
+    shift = pull_cop_shift_m(F.ravel(), hands, com, ground_z, WEIGHT_N)
+    assert shift == pytest.approx(cop_x - com[0], abs=1e-12)
+
+
+def test_a_backward_pull_moves_the_cop_back_by_its_moment_over_the_weight():
+    """Both hands pulled back 10 N at 0.35 m over the ground: the CoP 2 x 10 x 0.35 / W
+    behind the CoM; an upward pull in front of the CoM moves it back too, a forward one
+    forward; one lifting the robot cannot be held (-inf)."""
+    com = np.array([0.2, 0.0, 0.36])
+    hands = np.array([[0.35, 0.1, 0.36], [0.35, -0.1, 0.36]])
+    back = np.array([0, 0, 0, -10.0, 0, 0] * 2)
+    assert pull_cop_shift_m(back, hands, com, 0.01, WEIGHT_N) == pytest.approx(
+        -2 * 10.0 * 0.35 / WEIGHT_N
+    )
+    up = np.array([0, 0, 0, 0, 0, 10.0] * 2)  # 0.15 m in front of the CoM
+    assert pull_cop_shift_m(up, hands, com, 0.01, WEIGHT_N) == pytest.approx(
+        -2 * 10.0 * 0.15 / (WEIGHT_N - 20.0)
+    )
+    assert pull_cop_shift_m(-back, hands, com, 0.01, WEIGHT_N) > 0
+    lift = np.array([0, 0, 0, 0, 0, WEIGHT_N / 2 + 1] * 2)
+    assert pull_cop_shift_m(lift, hands, com, 0.01, WEIGHT_N) == -np.inf

@@ -220,10 +220,12 @@ class StandupConfig:
     # grips, never started at 10 N). N, s.
     gentle_pull_force_N: float = 6.5
     gentle_pull_time_s: float = 0.25
-    # Both hands together pulled backwards by more than this: the stand-up waits (each
-    # phase's when_hindered says how). 2 N per hand toppled the robot in state 2 under
-    # the first threshold of 8 N (docs/design.md, "A pull against the stand-up"). N.
-    hindering_force_threshold_N: float = 2.5
+    # A pull is against the stand-up by its effect: when holding it would need more than
+    # standing_pull_usage_limit of the CoM's reach back over the heels (guards.heel_usage);
+    # the stand-up then waits (each phase's when_hindered says how). Older files set
+    # this: both hands together pulled back by more than it counted too, whatever it did
+    # (2.5 until issue 31; a partner's lag dipping through zero sat the robot back). N.
+    hindering_force_threshold_N: float | None = None
     # A pull that would need more than this share of what the standing robot's feet can
     # hold (sensing.standing_pull_usage: its lean plus the soles' CoP boxes) is answered
     # as a hindering pull is: the stand-up waits, or sits back, until it eases. 20 N

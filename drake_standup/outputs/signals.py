@@ -107,6 +107,8 @@ def _station_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarr
         signals["standing_pull_usage"] = logs["standing_pull_usage"][:, 0]
     if "braced_pull_usage" in logs:  # the same, the standing robot's arms braced
         signals["braced_pull_usage"] = logs["braced_pull_usage"][:, 0]
+    if "pull_cop_shift_m" in logs:  # sensing.pull_cop_shift_m: the pull at the posture now
+        signals["pull_cop_shift_m"] = logs["pull_cop_shift_m"][:, 0]
     if "hand_velocities_W" in logs:  # [v_left, v_right] where the hands are pulled
         signals["hand_velocities_W"] = logs["hand_velocities_W"]
     if "helper_spent" in logs:  # human.HelperWork's running totals, on the plant's steps

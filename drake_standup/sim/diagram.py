@@ -35,6 +35,7 @@ STATION_SIGNALS = (
     "net_actuation",
     "standing_pull_usage",
     "braced_pull_usage",
+    "pull_cop_shift_m",
     "hand_velocities_W",
 )
 CONTROLLER_SIGNALS = (

@@ -57,9 +57,15 @@ class GuardSignals:
     hands_held: SchmittTrigger = _OFF
     feet_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # the feet together
     each_foot_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # each foot
-    # Both hands together pulled backwards (against the stand-up) by more than
-    # hindering_force_threshold_N.
+    # A pull against the stand-up: one needing more than standing_pull_usage_limit of
+    # the CoM's reach back over the heels (heel_usage), or, where a scenario sets
+    # hindering_force_threshold_N, both hands together pulled back by more than it.
     hindered: SchmittTrigger = _OFF
+    heel_usage: float = 0.0  # filtered
+    # The largest filtered backward force on both hands while hindered; kept until the
+    # backward force falls below guard_off_ratio of it (0: none). The same pull looks
+    # smaller seated, its lever shorter: it is still against the stand-up. N.
+    hindering_back_N: float = 0.0
     # A pull needing more than standing_pull_usage_limit of what the standing robot's
     # feet can hold (filtered usage; the trigger).
     pull_usage: float = 0.0
@@ -72,7 +78,7 @@ class GuardSignals:
 
     def against(self) -> bool:
         """A pull the stand-up cannot go on under: hindering, or beyond the feet."""
-        return self.hindered.on or self.beyond_feet.on
+        return self.hindered.on or self.beyond_feet.on or self.hindering_back_N > 0.0
 
 
 @dataclass(frozen=True)
@@ -92,9 +98,32 @@ class Measurements:
     # with the arms braced (NaN: not measured; the arms never brace).
     pull_usage: float = 0.0
     braced_usage: float = math.nan
+    # sensing.pull_cop_shift_m: how far the pull moves the centre of pressure under the
+    # robot at its posture now (negative: back; 0: not measured). m.
+    cop_shift_m: float = 0.0
     # Someone asked for the stand-up (live mode's "Stand up" button): with
     # trigger 'hands', as good as the pull.
     stand_up: bool = False
+
+
+# A pull that lifts the robot uses its reach this many times over (it stays finite
+# through the filter).
+_LIFTED_USAGE = 10.0
+
+
+def heel_usage(m: Measurements, table: PhaseTable) -> float:
+    """The share of the CoM's reach back over the heels that the pull's backward shift of
+    the centre of pressure needs (1: the CoP at the heels' edge). The reach is the CoM's
+    lead over the heels now, at least the lead with which the phases hand the robot to
+    its feet (their exits' com_ahead_of_heels_m): before then the seat holds the pull,
+    and what counts is whether the feet will."""
+    if m.cop_shift_m >= 0.0:
+        return 0.0
+    lead = max((p.exit.com_ahead_of_heels_m or 0.0 for p in table), default=0.0)
+    reach = max(float(m.com_W[0]) - m.heel_x, lead)
+    if reach <= 0.0 or math.isinf(m.cop_shift_m):
+        return _LIFTED_USAGE
+    return min(-m.cop_shift_m / reach, _LIFTED_USAGE)
 
 
 def _low_pass(previous: tuple[float, ...], raw: tuple[float, ...], gain: float) -> tuple:
@@ -109,15 +138,18 @@ def update_guards(
     filters), then the triggers of every phase's exit."""
     can_brace = cfg.brace_arms and not math.isnan(m.braced_usage)
     braced_raw = m.braced_usage if can_brace else 0.0
+    heel_raw = heel_usage(m, table)
     if math.isnan(g.t):
         feet, hands = tuple(m.foot_fz_N), tuple(m.hand_fx_N)
-        usage, braced = m.pull_usage, braced_raw
+        usage, braced, heel = m.pull_usage, braced_raw, heel_raw
     else:
         tau = cfg.force_filter_time_constant_s
         gain = 1.0 if tau <= 0 else 1.0 - math.exp(-max(m.t - g.t, 0.0) / tau)
         feet = _low_pass(g.foot_fz_N, m.foot_fz_N, gain)
         hands = _low_pass(g.hand_fx_N, m.hand_fx_N, gain)
-        usage, braced = _low_pass((g.pull_usage, g.braced_usage), (m.pull_usage, braced_raw), gain)
+        usage, braced, heel = _low_pass(
+            (g.pull_usage, g.braced_usage, g.heel_usage), (m.pull_usage, braced_raw, heel_raw), gain
+        )
     off, dwell = cfg.guard_off_ratio, cfg.guard_dwell_s
     limit = cfg.standing_pull_usage_limit
     brace = g.brace.update(usage, m.t, limit, off * limit, dwell) if can_brace else _OFF
@@ -128,8 +160,19 @@ def update_guards(
         return trigger.update(value, m.t, threshold, off * threshold, dwell)
 
     hand_on, back_on = cfg.hand_force_threshold_N, cfg.hindering_force_threshold_N
+    back = -sum(hands)
+    # The backward force itself counts only where a scenario sets its threshold (older
+    # files); judged by its effect, a pull is against the stand-up if the feet cannot
+    # hold it.
+    against = heel / limit
+    if back_on is not None:
+        against = max(against, back / back_on if back_on > 0 else (math.inf if back > 0 else 0.0))
     gentle = cfg.gentle_pull_force_N
     exits = [phase.exit for phase in table]
+    hindered = g.hindered.update(against, m.t, 1.0, off, dwell)
+    remembered = max(g.hindering_back_N, back) if hindered.on else g.hindering_back_N
+    if not hindered.on and back < off * remembered:
+        remembered = 0.0
     return GuardSignals(
         t=m.t,
         foot_fz_N=feet,
@@ -144,7 +187,9 @@ def update_guards(
         each_foot_loaded=tuple(
             trigger(k, min(feet), e.each_foot_force_N) for k, e in zip(g.each_foot_loaded, exits)
         ),
-        hindered=g.hindered.update(-sum(hands), m.t, back_on, off * back_on, dwell),
+        hindered=hindered,
+        heel_usage=heel,
+        hindering_back_N=remembered,
         pull_usage=usage,
         brace=brace,
         braced_usage=braced,

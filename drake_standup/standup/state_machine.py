@@ -32,6 +32,7 @@ class StandupStateMachine(LeafSystem):
 
     Inputs: psi (1), com_W (3), heel_x_W (1), thigh_x_W (1; unconnected: never passed),
     standing_pull_usage and braced_pull_usage (1 each; unconnected: 0, and never braced),
+    pull_cop_shift_m (1; unconnected: 0),
     pad_forces_W (3 per pad, rows of the soles
     given as sole_rows = (left, right)), hand_wrenches_W (12, payloads.HAND_WRENCHES), and
     stand_up (1; > 0.5: go; unconnected: never), which only the live helper has.
@@ -66,6 +67,7 @@ class StandupStateMachine(LeafSystem):
         self._thigh = self.DeclareVectorInputPort("thigh_x_W", 1)
         self._usage = self.DeclareVectorInputPort("standing_pull_usage", 1)
         self._braced_usage = self.DeclareVectorInputPort("braced_pull_usage", 1)
+        self._cop_shift = self.DeclareVectorInputPort("pull_cop_shift_m", 1)
         self._pads = self.DeclareVectorInputPort("pad_forces_W", 3 * n_pads)
         self._hands = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         self._stand_up = self.DeclareVectorInputPort("stand_up", 1)
@@ -114,6 +116,9 @@ class StandupStateMachine(LeafSystem):
             braced_usage=float(self._braced_usage.Eval(context)[0])
             if self._braced_usage.HasValue(context)
             else math.nan,
+            cop_shift_m=float(self._cop_shift.Eval(context)[0])
+            if self._cop_shift.HasValue(context)
+            else 0.0,
         )
 
     def _Update(self, context: Context, state: State) -> None:
@@ -137,7 +142,7 @@ class StandupStateMachine(LeafSystem):
         g = mode.guards
         output.SetFromVector(
             [
-                float(g.hindered.on),
+                float(g.hindered.on or g.hindering_back_N > 0.0),
                 mode.held_back_s,
                 float(g.beyond_feet.on),
                 mode.held_beyond_feet_s,

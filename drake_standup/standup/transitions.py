@@ -12,8 +12,9 @@ this module is its mechanism:
   the segment's end) keeps the reference's slope continuous across switches.
 - seat_loads: what is left of each seat pad's load while the phases release it (NaN
   while the pad is seated): the contact schedule's input (contact_schedule.py).
-- A pull against the stand-up (both hands together pulled backwards by more than
-  standup.hindering_force_threshold_N, through the same filter and trigger) is answered
+- A pull against the stand-up (one the feet could not hold: more than
+  standup.standing_pull_usage_limit of the CoM's reach back over the heels, guards.
+  heel_usage; or beyond the standing feet; through the same filter and trigger) is answered
   by the phase's when_hindered: wait (the guards wait for calm), sit_back (_sit_back: the
   reference returns to the seated CoM, state 1 again), step_back (while the pads this
   phase releases still carry more than reseat_above_thigh_load of their load: sit back;

@@ -92,6 +92,31 @@ def standing_lean(
     return d, np.array([forward + half_x, back + half_x, side + half_y])
 
 
+def pull_cop_shift_m(
+    hand_wrenches_W: np.ndarray,
+    hands_W: np.ndarray,
+    com_W: np.ndarray,
+    ground_z_m: float,
+    weight_N: float,
+) -> float:
+    """How far (x, m; negative: back) the hands' pull moves the centre of pressure under
+    the robot held still at its posture now: from the moments about the y axis of the
+    weight at the CoM and the hands' wrenches at hands_W (2 x 3, world), on the ground
+    at ground_z_m, (x_cop - x_com) (W - sum f_z) = sum (z_h - z_g) f_x - (x_h - x_com) f_z
+    + tau_y. A backward pull at the hands tips the robot back: the centre of pressure
+    moves toward the heels. -inf if the pull lifts the robot."""
+    F = np.asarray(hand_wrenches_W).reshape(2, 6)
+    hands = np.asarray(hands_W).reshape(2, 3)
+    load = weight_N - F[0, 5] - F[1, 5]
+    if load <= 0.0:
+        return -math.inf
+    moment = sum(
+        (hands[i, 2] - ground_z_m) * F[i, 3] - (hands[i, 0] - com_W[0]) * F[i, 5] + F[i, 1]
+        for i in range(2)
+    )
+    return float(moment / load)
+
+
 def standing_pull_usage(
     hand_wrenches_W: np.ndarray, weight_N: float, support: StandingSupport
 ) -> float:
@@ -113,7 +138,8 @@ class RobotSensing(LeafSystem):
     thigh pads' centres, where the seat's support ends; NaN without pads),
     hand_positions_W and hand_velocities_W (6 each, m and m/s: the left and the right
     hand frame's origin, where a pull is applied, human.hand_forces; what the helper's
-    work is summed over, human.HelperWork) and, with a
+    work is summed over, human.HelperWork), pull_cop_shift_m (1, m: pull_cop_shift_m of
+    the measured pull at the posture now, on the ground under the heels) and, with a
     StandingSupport, standing_pull_usage (1: standing_pull_usage of the measured pull).
 
     The CoM outputs share one cache entry that depends on robot_state only:
@@ -169,6 +195,12 @@ class RobotSensing(LeafSystem):
         self.DeclareVectorOutputPort(
             "hand_velocities_W", 6, self._CalcHandVelocities, prerequisites_of_calc=state_only
         )
+        self.DeclareVectorOutputPort(
+            "pull_cop_shift_m",
+            1,
+            self._CalcPullCopShift,
+            prerequisites_of_calc={self._state.ticket(), self._wrenches.ticket()},
+        )
         for name, support in (("standing_pull_usage", standing), ("braced_pull_usage", braced)):
             if support is not None:
                 self.DeclareVectorOutputPort(
@@ -206,12 +238,16 @@ class RobotSensing(LeafSystem):
 
         return calc
 
-    def _points_x(self, context: Context, points: list) -> list[float]:
-        """The world x of each (frame, point in it) at robot_state."""
+    def _points(self, context: Context, points: list) -> list[np.ndarray]:
+        """The world position of each (frame, point in it) at robot_state."""
         self._set_plant_state(context, check=True)
         plant, c = self._plant, self._context
         world = plant.world_frame()
-        return [plant.CalcPointsPositions(c, f, p.reshape(3, 1), world)[0, 0] for f, p in points]
+        return [plant.CalcPointsPositions(c, f, p.reshape(3, 1), world)[:, 0] for f, p in points]
+
+    def _points_x(self, context: Context, points: list) -> list[float]:
+        """The world x of each (frame, point in it) at robot_state."""
+        return [float(p[0]) for p in self._points(context, points)]
 
     def _CalcHeelX(self, context: Context, output: BasicVector) -> None:
         xs = self._points_x(context, self._heels)
@@ -246,6 +282,17 @@ class RobotSensing(LeafSystem):
             output.SetAtIndex(0, usage)
 
         return calc
+
+    def _CalcPullCopShift(self, context: Context, output: BasicVector) -> None:
+        F = self._wrenches.Eval(context)
+        if not np.count_nonzero(F) or not self._heels:
+            output.SetAtIndex(0, 0.0)
+            return
+        ground_z = float(np.mean([p[2] for p in self._points(context, self._heels)]))
+        hands = [f.CalcPoseInWorld(self._context).translation() for f in self._hands]
+        com = self._kinematics.Eval(context)[0]
+        weight = self._mass_kg * self._g
+        output.SetAtIndex(0, pull_cop_shift_m(F, np.array(hands), com, ground_z, weight))
 
     def _CalcOmegaF(self, context: Context, output: BasicVector) -> None:
         """Omega f = J_com M^-1 sum_h J_h^T F_h (paper, Sec. II).

@@ -21,6 +21,7 @@ Outputs
     hand_positions_W, hand_velocities_W   (6 each) where the hands are pulled, m, m/s
     standing_pull_usage       (1) the share of the standing feet's hold a pull needs
     braced_pull_usage         (1) the same with the arms braced (held as seated)
+    pull_cop_shift_m          (1) how far the pull moves the CoP under the posture now
     push_force_W              (3) only with perturbation.pushes
 """
 
@@ -232,6 +233,7 @@ def _add_sensing(
     for name in (
         "standing_pull_usage",
         "braced_pull_usage",
+        "pull_cop_shift_m",
         "hand_positions_W",
         "hand_velocities_W",
     ):
