@@ -213,7 +213,7 @@ def test_the_helpers_campaigns_draw_each_hand_over_the_envelope_and_share_their_
         ("base: scenarios/assisted.yaml\nsamples: 0\n", "samples: 0; accepted"),
         (
             "base: scenarios/assisted.yaml\nfigures: [{kind: pie, x: a, y: b}]\n",
-            "figures[0].kind: 'pie'; accepted: line | rate",
+            "figures[0].kind: 'pie'; accepted: line | rate | scatter",
         ),
         (
             "base: scenarios/assisted.yaml\nfigures: [{kind: rate, x: a, y: b, range: [2, 1]}]\n",
@@ -221,7 +221,7 @@ def test_the_helpers_campaigns_draw_each_hand_over_the_envelope_and_share_their_
         ),
         (
             "base: scenarios/assisted.yaml\nfigures: [{kind: rate, x: a, y: b, lines: [{x: 1}]}]\n",
-            "figures[0].lines: [{'x': 1}]; accepted: a list of {x: number, label: text}",
+            "figures[0].lines: [{'x': 1}]; accepted: a list of {x or y: number, label: text}",
         ),
     ],
 )
@@ -475,3 +475,44 @@ def test_a_rate_figure_draws_its_reference_lines(tmp_path):
         path = draw_figure(fig, records, tmp_path)
     assert path is not None and path.exists()
     assert [call.args[1] for call in axvline.call_args_list] == [9.3]
+
+
+def test_a_scatter_figure_plots_each_run_that_stood_and_its_horizontal_lines(tmp_path):
+    """scatter: each run that stood up at (x, y), one call per group, the others as
+    crosses on the x axis; a {y, label} line drawn horizontal (matplotlib's own record)."""
+    from unittest import mock
+
+    import matplotlib.axes
+
+    from drake_standup.studies.sweep_figures import Figure, draw_figure
+
+    records = [
+        {
+            "index": i,
+            "run_id": f"r{i}",
+            "params": {"grip_N": 10.0 + i, "guide": "path" if i % 2 else "velocity"},
+            "metrics": {"success": i != 4, "standup_time_s": 3.0 + 0.1 * i},
+        }
+        for i in range(6)
+    ]
+    fig = Figure(
+        kind="scatter",
+        x="grip_N",
+        y="standup_time_s",
+        group="guide",
+        lines=[{"y": 3.71, "label": "alone"}],
+    )
+    with (
+        mock.patch.object(matplotlib.axes.Axes, "axhline", autospec=True) as axhline,
+        mock.patch.object(matplotlib.axes.Axes, "plot", autospec=True, wraps=None) as plot,
+    ):
+        plot.return_value = [mock.Mock(get_color=lambda: "k")]
+        path = draw_figure(fig, records, tmp_path)
+    assert path is not None and path.exists()
+    assert [call.args[1] for call in axhline.call_args_list] == [3.71]
+    drawn = [(list(c.args[1]), list(c.args[2])) for c in plot.call_args_list]
+    assert drawn == [
+        ([11.0, 13.0, 15.0], [3.1, 3.3, 3.5]),  # path
+        ([10.0, 12.0], [3.0, 3.2]),  # velocity, stood
+        ([14.0], [0.0]),  # velocity, run 4 did not stand
+    ]

@@ -1,6 +1,6 @@
 """A sweep's figures, drawn from its run records as its sweep file asks (sweep_file.Figure):
-line (mean of a metric per parameter value, one line per group) or rate (a metric's rate
-per bin of a parameter)."""
+line (mean of a metric per parameter value, one line per group), rate (a metric's rate
+per bin of a parameter) or scatter (a metric per run against a random parameter)."""
 
 from __future__ import annotations
 
@@ -20,7 +20,8 @@ def _order(value):
 def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
     """line: mean y per x value (one line per group; runs that did not stand
     up drawn as crosses on the x axis); rate: mean of y (e.g. success) per x bin,
-    with the number of runs per bin."""
+    with the number of runs per bin; scatter: y of each run that stood up against its
+    x (one marker per group), the others as crosses on the x axis."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -30,9 +31,11 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
     if not rows or fig.x not in rows[0]:
         return None
     fig_obj, ax = plt.subplots(figsize=(6.4, 4.2))
-    if fig.kind == "line":
+    markers = "osD^v<>p"
+    if fig.kind == "scatter":
+        _scatter(ax, fig, rows, markers)
+    elif fig.kind == "line":
         groups = sorted({row.get(fig.group) for row in rows}, key=_order) if fig.group else [None]
-        markers = "osD^v<>p"
         for k, g in enumerate(groups):
             sel = [r for r in rows if fig.group is None or r.get(fig.group) == g]
             xs = sorted({r[fig.x] for r in sel}, key=_order)
@@ -77,7 +80,50 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
             ax.text(c, r + 0.02, f"n={n}", ha="center", fontsize=8)
         ax.set_ylim(0, 1.15)
         ax.set_ylabel(f"{fig.y} rate")
+    _reference_lines(ax, fig)
+    ax.set_xlabel(fig.x)
+    ax.set_title(fig.title or f"{fig.y} vs {fig.x}", fontsize=10)
+    ax.grid(alpha=0.3)
+    fig_obj.tight_layout()
+    path = out_dir / f"{fig.y}_vs_{fig.x}.png".replace("/", "_")
+    fig_obj.savefig(path, dpi=110)
+    plt.close(fig_obj)
+    return path
+
+
+def _scatter(ax, fig: Figure, rows: list[dict], markers: str) -> None:
+    """y of each run that stood up against its x, a marker per group; the others as
+    crosses on the x axis."""
+    groups = sorted({row.get(fig.group) for row in rows}, key=_order) if fig.group else [None]
+    for k, g in enumerate(groups):
+        sel = [r for r in rows if fig.group is None or r.get(fig.group) == g]
+        stood = [(r[fig.x], finite_number(r.get(fig.y))) for r in sel if r.get("success")]
+        stood = [(x, y) for x, y in stood if y is not None]
+        label = f"{fig.group} = {g}" if fig.group else None
+        (dots,) = ax.plot(*(zip(*stood) if stood else ([], [])), markers[k % 8], label=label)
+        failed = [r[fig.x] for r in sel if not r.get("success")]
+        if failed:
+            ax.plot(failed, [0.0] * len(failed), "x", color=dots.get_color(), ms=10, mew=2)
+    if fig.group:
+        ax.legend(fontsize=8)
+    ax.set_ylabel(fig.y)
+
+
+def _reference_lines(ax, fig: Figure) -> None:
+    """The figure's lines: {x, label} vertical, {y, label} horizontal."""
     for k, line in enumerate(fig.lines):
+        if "y" in line:  # horizontal, labelled at the left end
+            ax.axhline(line["y"], color="tab:red", ls="--", lw=1.2)
+            ax.text(
+                0.01,
+                line["y"],
+                f"{line['label']}",
+                transform=ax.get_yaxis_transform(),
+                color="tab:red",
+                fontsize=8,
+                va="bottom",
+            )
+            continue
         ax.axvline(line["x"], color="tab:red", ls="--", lw=1.2)
         ax.text(
             line["x"],
@@ -88,11 +134,3 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
             fontsize=8,
             va="top",
         )
-    ax.set_xlabel(fig.x)
-    ax.set_title(fig.title or f"{fig.y} vs {fig.x}", fontsize=10)
-    ax.grid(alpha=0.3)
-    fig_obj.tight_layout()
-    path = out_dir / f"{fig.y}_vs_{fig.x}.png".replace("/", "_")
-    fig_obj.savefig(path, dpi=110)
-    plt.close(fig_obj)
-    return path

@@ -53,14 +53,17 @@ class Parameter:
 
 @dataclass
 class Figure:
-    kind: str = "line"  # 'line': mean of y per x (per group); 'rate': mean of y per x bin
+    # 'line': mean of y per x (per group); 'rate': mean of y per x bin; 'scatter': y of
+    # each run against its x (per group), for random draws.
+    kind: str = "line"
     x: str = ""
     y: str = ""
     group: str | None = None
     bins: int = 6
     range: list[float] | None = None  # rate: the bins' span (default: the data's)
     title: str | None = None
-    # Vertical reference lines: [{x: value, label: text}], e.g. a bound from theory.
+    # Reference lines: [{x: value, label: text}] vertical, e.g. a bound from theory, or
+    # [{y: value, label: text}] horizontal, e.g. the time without help.
     lines: list[dict] = field(default_factory=list)
 
 
@@ -246,21 +249,21 @@ def _figure(where: str, entry) -> Figure:
     lines, span = figure.lines, figure.range
     if not isinstance(lines, list) or not all(
         isinstance(line, dict)
-        and set(line) == {"x", "label"}
-        and _number(line["x"])
+        and set(line) in ({"x", "label"}, {"y", "label"})
+        and _number(line.get("x", line.get("y")))
         and isinstance(line["label"], str)
         for line in lines
     ):
         raise SweepError(
-            f"{where}.lines: {lines!r}; accepted: a list of {{x: number, label: text}}"
+            f"{where}.lines: {lines!r}; accepted: a list of {{x or y: number, label: text}}"
         )
     if span is not None and not (
         isinstance(span, list) and len(span) == 2 and all(map(_number, span)) and span[0] < span[1]
     ):
         raise SweepError(f"{where}.range: {span!r}; accepted: [low, high] with low < high")
     _integer(f"{where}.bins", figure.bins, 1)
-    if figure.kind not in ("line", "rate"):
-        raise SweepError(f"{where}.kind: {figure.kind!r}; accepted: line | rate")
+    if figure.kind not in ("line", "rate", "scatter"):
+        raise SweepError(f"{where}.kind: {figure.kind!r}; accepted: line | rate | scatter")
     for key in ("x", "y"):
         if not isinstance(entry.get(key), str):
             raise SweepError(f"{where}.{key}: missing; accepted: a column of the results table")
