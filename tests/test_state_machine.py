@@ -92,13 +92,18 @@ def test_1_to_2_needs_balance_time_and_both_hands_over_threshold():
     assert _next(mode, _m(3.0, hands=(thr + 1e-9, thr + 1e-9)), cfg).state == 2
 
 
-def _first_state_2(force_N: float, cfg=CFG) -> float:
-    """When the stand-up starts (NaN: within 2 s it does not) under a pull of force_N on
-    both hands from 3 s, the guards updated every 10 ms."""
+def _first_state_2(force_N: float, cfg=CFG, up_N: float = 0.0) -> float:
+    """When the stand-up starts (NaN: within 2 s it does not) under a pull of force_N
+    forward and up_N up on both hands from 3 s, the guards updated every 10 ms."""
     mode = initial_mode(COM0)
     for k in range(500):
         t = 0.01 * k
-        mode = next_mode(mode, _m(t, hands=(force_N,) * 2 if t >= 3.0 else (0.0, 0.0)), cfg, TABLE)
+        on = t >= 3.0
+        m = dataclasses.replace(
+            _m(t, hands=(force_N,) * 2 if on else (0.0, 0.0)),
+            hand_fz_N=(up_N,) * 2 if on else (0.0, 0.0),
+        )
+        mode = next_mode(mode, m, cfg, TABLE)
         if mode.state == 2:
             return mode.entry_times_s[1]
     return math.nan
@@ -114,6 +119,21 @@ def test_a_gentle_pull_starts_the_stand_up_once_held_for_a_reaction_time():
     crossed = 3.0 + CFG.force_filter_time_constant_s * math.log(8.0 / 1.5)
     assert gentle == pytest.approx(crossed + CFG.gentle_pull_time_s, abs=0.021)
     assert math.isnan(_first_state_2(6.0))
+
+
+def test_a_gentle_grip_counts_forward_and_up():
+    """A 9 N grip along a 45-degree pace pulls 6.4 N forward and 6.4 N up: below 6.5 N
+    forward, yet a request to stand, held as the 9 N it is (the same start as 9 N
+    forward); 6 N each way never starts it; a press down is not counted (8 N forward
+    pressed down starts as 8 N forward, 8 N down alone never), nor is a pull back (one
+    up as much as it is back starts as its lift; its effect is the hindering guard's)."""
+    side = 9.0 / math.sqrt(2.0)
+    assert _first_state_2(side, up_N=side) == pytest.approx(_first_state_2(9.0), abs=1e-9)
+    assert not math.isnan(_first_state_2(side, up_N=side))
+    assert math.isnan(_first_state_2(6.0 / math.sqrt(2.0), up_N=6.0 / math.sqrt(2.0)))
+    assert _first_state_2(8.0, up_N=-8.0) == pytest.approx(_first_state_2(8.0), abs=1e-9)
+    assert math.isnan(_first_state_2(0.0, up_N=-8.0))
+    assert _first_state_2(-8.0, up_N=8.0) == pytest.approx(_first_state_2(0.0, up_N=8.0))
 
 
 def test_1_to_2_with_time_trigger_ignores_hands():

@@ -83,20 +83,26 @@ def test_a_pull_that_lifts_the_robot_is_beyond_the_feet():
 
 
 def _moment_y_about(p_x, ground_z, com, hands, F, weight_N):
-    """The y moment about the ground point (p_x, *, ground_z) of the weight at the CoM and
-    the hands' wrenches (3-D cross products)."""
+    """The y moment about the ground point (p_x, *, ground_z) of the weight at the CoM, the
+    hands' moments, their horizontal forces and their downward forces at the hands, a
+    lift acting below the CoM (its own lever left out, sensing.pull_cop_shift_m), by 3-D
+    cross products."""
     p = np.array([p_x, 0.0, ground_z])
     total = np.cross(com - p, [0.0, 0.0, -weight_N])
     for h in range(2):
-        total = total + np.cross(hands[h] - p, F[h, 3:]) + F[h, :3]
+        horizontal = np.array([F[h, 3], F[h, 4], 0.0])
+        vertical = np.array([0.0, 0.0, F[h, 5]])
+        at = hands[h] if F[h, 5] < 0.0 else np.array([com[0], hands[h, 1], hands[h, 2]])
+        total = total + np.cross(hands[h] - p, horizontal) + np.cross(at - p, vertical)
+        total = total + F[h, :3]
     return total[1]
 
 
 @pytest.mark.parametrize("seed", range(5))
 def test_the_pull_moves_the_cop_to_where_the_moments_balance(seed):
-    """The CoP is the ground point about which the weight, the hands' wrenches and the
-    ground's reaction (acting there) have no y moment: found by the linear root of the
-    moment written with 3-D cross products; the shift is its x from the CoM's."""
+    """The CoP is the ground point about which the weight, the pull and the ground's
+    reaction (acting there) have no y moment: found by the linear root of the moment
+    written with 3-D cross products; the shift is its x from the CoM's."""
     rng = np.random.default_rng(seed)
     com = np.array([0.15, 0.0, 0.35]) + rng.uniform(-0.05, 0.05, 3)
     hands = np.array([[0.3, 0.12, 0.4], [0.3, -0.12, 0.4]]) + rng.uniform(-0.1, 0.1, (2, 3))
@@ -110,18 +116,20 @@ def test_the_pull_moves_the_cop_to_where_the_moments_balance(seed):
 
 def test_a_backward_pull_moves_the_cop_back_by_its_moment_over_the_weight():
     """Both hands pulled back 10 N at 0.35 m over the ground: the CoP 2 x 10 x 0.35 / W
-    behind the CoM; an upward pull in front of the CoM moves it back too, a forward one
-    forward; one lifting the robot cannot be held (-inf)."""
+    behind the CoM, a forward pull as far forward; pressed down 10 N each 0.15 m in front
+    of the CoM: 2 x 10 x 0.15 / (W + 20) forward; an upward pull in front of the CoM is
+    left to the standing feet (no shift here); one lifting the robot cannot be held
+    (-inf)."""
     com = np.array([0.2, 0.0, 0.36])
     hands = np.array([[0.35, 0.1, 0.36], [0.35, -0.1, 0.36]])
     back = np.array([0, 0, 0, -10.0, 0, 0] * 2)
-    assert pull_cop_shift_m(back, hands, com, 0.01, WEIGHT_N) == pytest.approx(
-        -2 * 10.0 * 0.35 / WEIGHT_N
+    expected = -2 * 10.0 * 0.35 / WEIGHT_N
+    assert pull_cop_shift_m(back, hands, com, 0.01, WEIGHT_N) == pytest.approx(expected)
+    assert pull_cop_shift_m(-back, hands, com, 0.01, WEIGHT_N) == pytest.approx(-expected)
+    down = np.array([0, 0, 0, 0, 0, -10.0] * 2)
+    assert pull_cop_shift_m(down, hands, com, 0.01, WEIGHT_N) == pytest.approx(
+        2 * 10.0 * 0.15 / (WEIGHT_N + 20.0)
     )
-    up = np.array([0, 0, 0, 0, 0, 10.0] * 2)  # 0.15 m in front of the CoM
-    assert pull_cop_shift_m(up, hands, com, 0.01, WEIGHT_N) == pytest.approx(
-        -2 * 10.0 * 0.15 / (WEIGHT_N - 20.0)
-    )
-    assert pull_cop_shift_m(-back, hands, com, 0.01, WEIGHT_N) > 0
+    assert pull_cop_shift_m(-down, hands, com, 0.01, WEIGHT_N) == 0.0
     lift = np.array([0, 0, 0, 0, 0, WEIGHT_N / 2 + 1] * 2)
     assert pull_cop_shift_m(lift, hands, com, 0.01, WEIGHT_N) == -np.inf

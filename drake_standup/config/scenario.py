@@ -213,11 +213,12 @@ class StandupConfig:
     trigger: str = "hands"
     # x component of the force on each hand that starts the stand-up. N.
     hand_force_threshold_N: float = 10.0
-    # ... or a gentler pull held longer: both hands pulled forward by more than the
-    # real iCub's hands register with nobody helping (SPEC 9: 5.4/6.5 N peak, states
-    # 2-3), for a person's reaction time (SPEC 10: 0.15-0.25 s). A firm pull starts it at
-    # once, a gentle grip once it is plainly meant (issue 31: 12 of 48 partners, 8-26 N
-    # grips, never started at 10 N). N, s.
+    # ... or a gentler pull held longer: both hands pulled the stand-up's way (forward
+    # and up, guards.helping_pull_N) by more than the real iCub's hands register with
+    # nobody helping (SPEC 9: 5.4/6.5 N peak, states 2-3), for a person's reaction time
+    # (SPEC 10: 0.15-0.25 s). A firm pull starts it at once, a gentle grip once it is
+    # plainly meant (issue 31: 12 of 48 partners, 8-26 N grips, never started at 10 N;
+    # 2 more, 9 N along a 45-degree pace, on the forward force alone). N, s.
     gentle_pull_force_N: float = 6.5
     gentle_pull_time_s: float = 0.25
     # A pull is against the stand-up by its effect: when holding it would need more than

@@ -109,6 +109,7 @@ class StandupStateMachine(LeafSystem):
             else math.nan,
             foot_fz_N=(float(pads[left, 2]), float(pads[right, 2])),
             hand_fx_N=(float(hands[0, 3]), float(hands[1, 3])),
+            hand_fz_N=(float(hands[0, 5]), float(hands[1, 5])),
             stand_up=self._stand_up.HasValue(context) and self._stand_up.Eval(context)[0] > 0.5,
             pull_usage=float(self._usage.Eval(context)[0])
             if self._usage.HasValue(context)

@@ -99,19 +99,25 @@ def pull_cop_shift_m(
     ground_z_m: float,
     weight_N: float,
 ) -> float:
-    """How far (x, m; negative: back) the hands' pull moves the centre of pressure under
+    """How far (x, m; negative: back) the hands' pull tips the centre of pressure under
     the robot held still at its posture now: from the moments about the y axis of the
-    weight at the CoM and the hands' wrenches at hands_W (2 x 3, world), on the ground
-    at ground_z_m, (x_cop - x_com) (W - sum f_z) = sum (z_h - z_g) f_x - (x_h - x_com) f_z
-    + tau_y. A backward pull at the hands tips the robot back: the centre of pressure
-    moves toward the heels. -inf if the pull lifts the robot."""
+    weight at the CoM and of the hands' wrenches at hands_W (2 x 3, world), on the ground
+    at ground_z_m, over the load the feet carry,
+    (x_cop - x_com) (W - sum f_z) = sum (z_h - z_g) f_x - (x_h - x_com) min(f_z, 0) + tau_y.
+    A backward pull at the hands tips the robot back toward the heels; a hand pressed
+    down in front of the CoM holds it forward. A lift's own lever is left out (a hand
+    lifted in front of the CoM moves the CoP back too): a lift is help the robot leans
+    into, and what the feet can hold of it is standing_pull_usage's to judge. -inf if
+    the pull lifts the robot."""
     F = np.asarray(hand_wrenches_W).reshape(2, 6)
     hands = np.asarray(hands_W).reshape(2, 3)
     load = weight_N - F[0, 5] - F[1, 5]
     if load <= 0.0:
         return -math.inf
     moment = sum(
-        (hands[i, 2] - ground_z_m) * F[i, 3] - (hands[i, 0] - com_W[0]) * F[i, 5] + F[i, 1]
+        (hands[i, 2] - ground_z_m) * F[i, 3]
+        - (hands[i, 0] - com_W[0]) * min(F[i, 5], 0.0)
+        + F[i, 1]
         for i in range(2)
     )
     return float(moment / load)
