@@ -78,9 +78,13 @@ class GuardSignals:
     braced_usage: float = 0.0
     beyond_feet: SchmittTrigger = _OFF
 
+    def hindering(self) -> bool:
+        """A pull against the stand-up: the trigger, or the pull that set it not yet eased."""
+        return self.hindered.on or self.hindering_back_N > 0.0
+
     def against(self) -> bool:
         """A pull the stand-up cannot go on under: hindering, or beyond the feet."""
-        return self.hindered.on or self.beyond_feet.on or self.hindering_back_N > 0.0
+        return self.hindering() or self.beyond_feet.on
 
 
 @dataclass(frozen=True)

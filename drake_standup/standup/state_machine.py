@@ -143,7 +143,7 @@ class StandupStateMachine(LeafSystem):
         g = mode.guards
         output.SetFromVector(
             [
-                float(g.hindered.on or g.hindering_back_N > 0.0),
+                float(g.hindering()),
                 mode.held_back_s,
                 float(g.beyond_feet.on),
                 mode.held_beyond_feet_s,

@@ -35,9 +35,7 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
     if fig.kind == "scatter":
         _scatter(ax, fig, rows, markers)
     elif fig.kind == "line":
-        groups = sorted({row.get(fig.group) for row in rows}, key=_order) if fig.group else [None]
-        for k, g in enumerate(groups):
-            sel = [r for r in rows if fig.group is None or r.get(fig.group) == g]
+        for k, (g, sel) in enumerate(_groups(fig, rows)):
             xs = sorted({r[fig.x] for r in sel}, key=_order)
             stood = [(r[fig.x], finite_number(r.get(fig.y))) for r in sel if r.get("success")]
             mean = [
@@ -91,16 +89,23 @@ def draw_figure(fig: Figure, records: list[dict], out_dir: Path) -> Path | None:
     return path
 
 
+def _groups(fig: Figure, rows: list[dict]) -> list[tuple]:
+    """(value, its rows) per value of fig.group in order; one (None, every row) without."""
+    if not fig.group:
+        return [(None, rows)]
+    values = sorted({row.get(fig.group) for row in rows}, key=_order)
+    return [(g, [r for r in rows if r.get(fig.group) == g]) for g in values]
+
+
 def _scatter(ax, fig: Figure, rows: list[dict], markers: str) -> None:
     """y of each run that stood up against its x, a marker per group; the others as
     crosses on the x axis."""
-    groups = sorted({row.get(fig.group) for row in rows}, key=_order) if fig.group else [None]
-    for k, g in enumerate(groups):
-        sel = [r for r in rows if fig.group is None or r.get(fig.group) == g]
+    for k, (g, sel) in enumerate(_groups(fig, rows)):
         stood = [(r[fig.x], finite_number(r.get(fig.y))) for r in sel if r.get("success")]
         stood = [(x, y) for x, y in stood if y is not None]
         label = f"{fig.group} = {g}" if fig.group else None
-        (dots,) = ax.plot(*(zip(*stood) if stood else ([], [])), markers[k % 8], label=label)
+        marker = markers[k % len(markers)]
+        (dots,) = ax.plot(*(zip(*stood) if stood else ([], [])), marker, label=label)
         failed = [r[fig.x] for r in sel if not r.get("success")]
         if failed:
             ax.plot(failed, [0.0] * len(failed), "x", color=dots.get_color(), ms=10, mew=2)

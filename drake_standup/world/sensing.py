@@ -195,7 +195,7 @@ class RobotSensing(LeafSystem):
         self.DeclareVectorOutputPort(
             "omega_f_W", 3, self._CalcOmegaF, prerequisites_of_calc={self._wrenches.ticket()}
         )
-        self.DeclareVectorOutputPort(
+        self._hand_positions = self.DeclareVectorOutputPort(
             "hand_positions_W", 6, self._CalcHandPositions, prerequisites_of_calc=state_only
         )
         self.DeclareVectorOutputPort(
@@ -295,10 +295,10 @@ class RobotSensing(LeafSystem):
             output.SetAtIndex(0, 0.0)
             return
         ground_z = float(np.mean([p[2] for p in self._points(context, self._heels)]))
-        hands = [f.CalcPoseInWorld(self._context).translation() for f in self._hands]
+        hands = self._hand_positions.Eval(context)  # the cached hand_positions_W
         com = self._kinematics.Eval(context)[0]
         weight = self._mass_kg * self._g
-        output.SetAtIndex(0, pull_cop_shift_m(F, np.array(hands), com, ground_z, weight))
+        output.SetAtIndex(0, pull_cop_shift_m(F, hands, com, ground_z, weight))
 
     def _CalcOmegaF(self, context: Context, output: BasicVector) -> None:
         """Omega f = J_com M^-1 sum_h J_h^T F_h (paper, Sec. II).
