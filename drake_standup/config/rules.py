@@ -82,6 +82,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "robot.effort_limit_Nm robot.visual_max_faces visualization.*period_s "
         "human.pulls[*].duration_s human.reactive.duration_s human.reactive.force_cap_N "
         "human.reactive.pace_mps advancement.eps advancement.psi_ddot_filter_s "
+        "advancement.full_help_pull_N "
         "phases.*.segment_psi phases.*.com_height_m standup.update_period_s "
         "standup.standing_pull_usage_limit standup.gentle_pull_force_N "
         "controller.momentum_weight controller.*_time_constant_s "

@@ -41,6 +41,7 @@ psi_dot 2.5 drove the knees onto their stop, measured).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 
@@ -54,6 +55,14 @@ from drake_standup.ports.caching import declare_cached
 # The tangent of a phase that holds psi = t (read only).
 _NO_TANGENT = np.zeros(3)
 _NO_TANGENT.flags.writeable = False
+
+
+def for_robot(config: AdvancementConfig, mass_kg: float) -> AdvancementConfig:
+    """config with alpha_full_mps2 derived where it is None: the CoM acceleration
+    full_help_pull_N on each hand along the path gives a robot of mass_kg."""
+    if config.alpha_full_mps2 is not None:
+        return config
+    return dataclasses.replace(config, alpha_full_mps2=2.0 * config.full_help_pull_N / mass_kg)
 
 
 def helpfulness(tangent: np.ndarray, omega_f: np.ndarray, eps: float) -> float:
@@ -139,6 +148,8 @@ class TrajectoryAdvancement(LeafSystem):
 
     def __init__(self, config: AdvancementConfig):
         super().__init__()
+        if config.alpha_full_mps2 is None:
+            raise ValueError("advancement.alpha_full_mps2 is None: resolve it with for_robot")
         self._config = config
         self.DeclareContinuousState(BasicVector([0.0, 1.0]))
         self._com = self.DeclareVectorInputPort("com_W", 3)

@@ -40,7 +40,7 @@ from drake_standup.config import Scenario
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
-from drake_standup.standup.advancement import TrajectoryAdvancement
+from drake_standup.standup.advancement import TrajectoryAdvancement, for_robot
 from drake_standup.standup.com_path import CoMReferenceGenerator
 from drake_standup.standup.contact_schedule import ContactSchedule
 from drake_standup.standup.plan import StandupPlan
@@ -134,7 +134,12 @@ def make_standup_controller(
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()
         ),
-        "advancement": TrajectoryAdvancement(scenario.advancement),
+        "advancement": TrajectoryAdvancement(
+            for_robot(
+                scenario.advancement,
+                plant.CalcTotalMass(plant.CreateDefaultContext(), [robot.model_instance]),
+            )
+        ),
         "com_reference": CoMReferenceGenerator(),
         "controller": StandupWholeBodyController(
             ContactSchedule(config, table),

@@ -1,7 +1,7 @@
 """The reactive partner: a person guiding each of the robot's hands, as forces from what
 they see of the robot (HumanWrenchSource, human.py, evaluates them):
 - velocity guide (reactive_force): along a direction at a pace, from wherever they saw
-  the hand; they follow a hand that outruns them.
+  the hand; they follow a hand that outruns them, still pulling it (lead_min ahead).
 - path guide (path_force): along a path in the sagittal plane at a pace, between
   lead_min and lead_max ahead of the hand, only forwards along the path.
 Both decide on what they saw reaction_time_s ago (the caller's `seen`), act on the hand
@@ -48,10 +48,13 @@ def reactive_force(
 
     Their own progress along u is the pace |v| (t - start), at most travel_m. They move
     the hand from where they saw it (seen: its position and velocity reaction_time_s
-    ago; None: now) to that progress: the target is p_seen + max(s_pace - s_seen, 0) u,
-    so a hand that outruns them, or swings across u, is followed, not pulled back to a
-    line in space; their arm's impedance acts on the hand now, along u (across it their
-    arm yields):
+    ago; None: now) to that progress, and follow a hand that outruns it keeping lead_min_m
+    ahead of it (their grip's pull; only while their reach, travel_m, lasts):
+        s_target = max(s_pace, min(s_seen + lead_min, max(travel, s_seen))),
+        target = p_seen + (s_target - s_seen) u,
+    so a hand that outruns them, or swings across u, is followed and still helped, never
+    pulled back to a line in space; their arm's impedance acts on the hand now, along u
+    (across it their arm yields):
         F = [(K (target - p_hand) + D (v_target - v_hand)) . u] u,
     v_target the target's velocity: the hand's as seen, at least the pace along u (a
     person leading a hand that moves faster than their pace follows its speed: the
@@ -66,10 +69,14 @@ def reactive_force(
     u = v_pace / speed if speed > 0 else np.zeros(3)
     walked = speed * (t - cfg.start_s)
     s_pace = min(walked, cfg.travel_m)
-    ahead = s_pace - float((p_seen - p_start) @ u)
+    s_seen = float((p_seen - p_start) @ u)
+    # Following a hand that outruns their pace they keep lead_min_m ahead of it (their
+    # grip's pull, as the path guide does) until their reach, travel_m, is used up.
+    s_follow = min(s_seen + cfg.lead_min_m, max(cfg.travel_m, s_seen))
+    ahead = max(s_pace, s_follow) - s_seen
     target, v_target = p_seen, v_seen
     if ahead > 0.0:  # the person leads the hand along u, never slower than they see it go
-        pacing = speed if walked < cfg.travel_m else 0.0
+        pacing = speed if walked < cfg.travel_m and s_pace >= s_follow else 0.0
         target = p_seen + ahead * u
         v_target = v_seen + max(pacing - float(v_seen @ u), 0.0) * u
     # Along u only: across it the person's arm yields (a spring there, to where they saw
