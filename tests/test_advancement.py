@@ -14,13 +14,18 @@ from pydrake.systems.analysis import Simulator
 from drake_standup.config import RESPONSES, AdvancementConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.robot.icub import ContactModel, add_icub
-from drake_standup.standup.advancement import TrajectoryAdvancement, lead, psi_dot_law
+from drake_standup.standup.advancement import (
+    TrajectoryAdvancement,
+    for_robot,
+    lead,
+    psi_dot_law,
+)
 from drake_standup.world.sensing import RobotSensing
 
 # The paper's on/off law (alpha_full <= alpha_min): the laws' values below are the
 # paper's and the authors' formulas; the graded gates have tests of their own.
 CFG = AdvancementConfig(alpha_full_mps2=0.0)
-GRADED = AdvancementConfig()
+GRADED = for_robot(AdvancementConfig(), 33.0)  # alpha_full from 10 N per hand on 33 kg
 TANGENT = np.array([0.12, 0.0, 0.02])  # a state-2-like path tangent, m per unit psi
 
 
@@ -205,18 +210,18 @@ def test_graded_lead_gate_is_continuous_in_the_lag():
 
 
 def test_lead_gate_waits_while_the_com_lags():
-    """Helped and fast, but 1 cm behind the reference along the path: no
-    advancement with the gate (the default), the paper's ratio without it."""
+    """Helped and fast, but 2 cm behind the reference along the path (beyond the 1.5 cm
+    tolerance): no advancement with the gate (the default), the paper's ratio without it."""
     v = 1.8 * TANGENT
     omega_f = TANGENT / np.linalg.norm(TANGENT)
     x_d = np.array([0.2, 0.0, 0.4])
-    behind = x_d - 0.01 * TANGENT / np.linalg.norm(TANGENT)
+    behind = x_d - 0.02 * TANGENT / np.linalg.norm(TANGENT)
     lag = lead(behind, x_d, TANGENT)
-    assert lag == pytest.approx(-0.01)
+    assert lag == pytest.approx(-0.02)
     assert psi_dot_law(CFG, v, omega_f, TANGENT, lag)[0] == 1.0
     assert psi_dot_law(_cfg(lead_gate=False), v, omega_f, TANGENT, lag)[0] > 1.7
     # Within the tolerance (the tracker's steady lag) it advances, fully on a lead.
-    assert psi_dot_law(CFG, v, omega_f, TANGENT, -0.004)[0] > 1.0
+    assert psi_dot_law(CFG, v, omega_f, TANGENT, -0.014)[0] > 1.0
     assert psi_dot_law(CFG, v, omega_f, TANGENT, 0.001)[0] > 1.7
 
 
@@ -297,3 +302,33 @@ def test_hand_velocities_are_the_hand_origins_displacement_rate():
         q_next[:4] /= np.linalg.norm(q_next[:4])
         expected = (origins(q_next) - origins(q)) / eps
         np.testing.assert_allclose(measured, expected, rtol=1e-4, atol=1e-5)
+
+
+def test_full_help_is_a_trained_helpers_pull_on_the_robots_mass():
+    """alpha_full (None by default) is what full_help_pull_N on each hand, along the path,
+    does to the CoM: the law acts in full from exactly that pull on (RobotSensing's Omega f,
+    at any posture), graded below it; an explicit alpha_full is kept."""
+    assert for_robot(AdvancementConfig(alpha_full_mps2=0.9), 33.0).alpha_full_mps2 == 0.9
+    with pytest.raises(ValueError, match="alpha_full_mps2"):
+        TrajectoryAdvancement(AdvancementConfig())
+    plant, sensing, context, _, _ = _sensing_rig()
+    cfg = for_robot(AdvancementConfig(), plant.CalcTotalMass(plant.CreateDefaultContext()))
+    assert cfg.alpha_full_mps2 == pytest.approx(2.0 * 10.0 / 33.06, rel=1e-3)
+    unit = TANGENT / np.linalg.norm(TANGENT)
+    v = 1.8 * TANGENT
+    ratio = (v @ TANGENT) / (TANGENT @ TANGENT + cfg.eps)
+    x = plant.GetPositionsAndVelocities(plant.CreateDefaultContext())
+    sensing.GetInputPort("robot_state").FixValue(context, x)
+
+    def law(per_hand_N):
+        f = per_hand_N * unit
+        wrenches = np.concatenate([np.zeros(3), f, np.zeros(3), f])
+        sensing.GetInputPort("hand_wrenches_W").FixValue(context, wrenches)
+        return psi_dot_law(cfg, v, sensing.GetOutputPort("omega_f_W").Eval(context), TANGENT)
+
+    psi_dot, alpha = law(10.0 * (1.0 + 1e-9))
+    assert alpha == pytest.approx(cfg.alpha_full_mps2, rel=1e-6)
+    assert psi_dot == pytest.approx(ratio, rel=1e-9)
+    w = (law(5.0)[1] - cfg.alpha_min_mps2) / (cfg.alpha_full_mps2 - cfg.alpha_min_mps2)
+    assert law(5.0)[0] == pytest.approx(1.0 + w * (ratio - 1.0), rel=1e-9)
+    assert 0.3 < w < 0.5

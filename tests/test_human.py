@@ -99,7 +99,10 @@ def test_pulls_change_linear_momentum_by_their_impulse(limp_robot_rig):
 
 
 def test_reactive_human_pulls_toward_target_within_cap():
-    cfg = ReactiveHumanConfig(start_s=1.0, duration_s=5.0, ramp_s=0.5, force_cap_N=20.0)
+    # The pace alone (no lead kept ahead of the hand: lead_min_m 0).
+    cfg = ReactiveHumanConfig(
+        start_s=1.0, duration_s=5.0, ramp_s=0.5, force_cap_N=20.0, lead_min_m=0.0
+    )
     start = np.array([0.24, 0.01, 0.31])
     assert not reactive_force(cfg, 0.9, start, np.zeros(3), start).any()
     # Mid-pull, hand still at the start: pulled along the pace's direction u, by the
@@ -136,6 +139,7 @@ def _person(**kw) -> ReactiveHumanConfig:
         force_cap_N=50.0,
         target_velocity_mps=list(0.1 * U),
         travel_m=0.3,
+        lead_min_m=0.0,  # the pace alone; test_person_keeps_pulling_a_hand_that_outruns_them
     )
     values.update(kw)
     return ReactiveHumanConfig(**values)
@@ -153,6 +157,27 @@ def test_person_follows_a_hand_that_outruns_them():
     np.testing.assert_allclose(
         reactive_force(cfg, 2.0, now, v, P0, seen=(seen, v)), -7.5 * U, atol=1e-12
     )
+
+
+def test_person_keeps_pulling_a_hand_that_outruns_them():
+    """lead_min_m 0.05: at t = 2 s the pace is 0.1 m along u. A hand seen 0.2 m along u,
+    moving at 0.5 m/s, is led 0.05 m ahead, the target moving with it: K 0.05 = 5 N
+    along u, no damping. Seen 0.15 s ago it has moved on 0.075 m: K (0.05 - 0.075)."""
+    cfg, v = _person(lead_min_m=0.05), 0.5 * U
+    seen = P0 + 0.2 * U
+    np.testing.assert_allclose(reactive_force(cfg, 2.0, seen, v, P0), 5.0 * U, atol=1e-12)
+    now = seen + 0.075 * U
+    np.testing.assert_allclose(
+        reactive_force(cfg, 2.0, now, v, P0, seen=(seen, v)), -2.5 * U, atol=1e-12
+    )
+    # Behind the pace the pace leads (0.02 m along u: K 0.08 + D (0.1 - 0)), ...
+    np.testing.assert_allclose(
+        reactive_force(cfg, 2.0, P0 + 0.02 * U, np.zeros(3), P0), 9.0 * U, atol=1e-12
+    )
+    # ... and the lead ends with the person's reach (travel 0.3 m): 0.02 m short of it,
+    # K 0.02; beyond it the hand is followed, never pulled back.
+    np.testing.assert_allclose(reactive_force(cfg, 2.0, P0 + 0.28 * U, v, P0), 2.0 * U, atol=1e-12)
+    assert not reactive_force(cfg, 2.0, P0 + 0.4 * U, v, P0).any()
 
 
 def test_a_person_leading_a_fast_hand_speeds_up_with_it():
