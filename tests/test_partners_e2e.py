@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from drake_standup.config import SCENARIO_DIR, load_scenario
+from drake_standup.config import SCENARIO_DIR, Scenario, load_scenario
 from drake_standup.sim.simulate import simulate
 
 pytestmark = pytest.mark.slow
@@ -49,4 +49,8 @@ def test_partner_stands_the_robot_up_15_percent_sooner(partner, alone):
     assert m["success"], m["failure_reason"]
     assert m["sit_backs"] == 0 and m["qp_failures"] == 0
     assert m["standing_at_end"]
-    assert m["standup_time_s"] <= 0.85 * alone, (m["standup_time_s"], alone)
+    # Within one logged sample (the stand-up time's resolution, 10 ms) of 15 % sooner: the
+    # gentle partner at 3 s measures 3.15 s against a bound of 3.1535 s here, and a sample's
+    # shift on another machine's numerics is not a change of behaviour.
+    sample = Scenario().log_period_s
+    assert m["standup_time_s"] <= 0.85 * alone + sample, (m["standup_time_s"], alone)
