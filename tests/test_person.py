@@ -53,10 +53,9 @@ def test_segments_are_the_tables(height_m, mass_kg):
     assert vertex[2] == pytest.approx(height_m, abs=1e-12)
     for name, (mass_pct, length_mm, com_pct) in TABLE.items():
         length = length_mm / 1000.0 * scale
-        along = com_pct / 100.0 if name in LIMBS else 1.0 - com_pct / 100.0
-        down = -1.0 if name in LIMBS or name == "lower_trunk" else 1.0
-        if name == "lower_trunk":
-            along = com_pct / 100.0
+        first = name in LIMBS or name == "lower_trunk"  # hangs from its first landmark
+        along = com_pct / 100.0 if first else 1.0 - com_pct / 100.0
+        down = -1.0 if first else 1.0
         for key in [f"{side}_{name}" for side in ("left", "right")] if name in LIMBS else [name]:
             inertia = plant.GetBodyByName(key).default_spatial_inertia()
             assert inertia.get_mass() == pytest.approx(mass_pct / 100.0 * mass_kg, rel=1e-12)

@@ -130,20 +130,18 @@ def make_standup_controller(
         station.arm_joints,
         station.braced_drop_m,
     )
+    model = ControllerModel(plant, robot, specs, config, period_s)
     systems = {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()
         ),
         "advancement": TrajectoryAdvancement(
-            for_robot(
-                scenario.advancement,
-                plant.CalcTotalMass(plant.CreateDefaultContext(), [robot.model_instance]),
-            )
+            for_robot(scenario.advancement, model.kinematics.nominal_mass_kg)
         ),
         "com_reference": CoMReferenceGenerator(),
         "controller": StandupWholeBodyController(
             ContactSchedule(config, table),
-            ControllerModel(plant, robot, specs, config, period_s),
+            model,
             ReferenceGenerator(
                 config,
                 schedule,

@@ -79,7 +79,7 @@ DE_LEVA_MALE = {
 }
 # The shoulders' height above XYPH: de Leva's other upper trunk, XYPH to SUPR (the
 # suprasternale, the shoulders' level), 170.7 mm on 1741; a fraction of stature.
-SHOULDER_ABOVE_XYPH = 170.7 / 1741.0
+SHOULDER_ABOVE_XYPH = 0.1707 / REFERENCE_STATURE_M
 # Shoulder and hip half-widths, fractions of stature (Dumas et al. 2007, via HeiMan).
 SHOULDER_HALF_WIDTH = 0.10
 HIP_HALF_WIDTH = 0.0461
@@ -142,20 +142,22 @@ ORIGIN = {
 }
 
 
-def segment_com(segment: Segment, name: str, height_m: float) -> np.ndarray:
+def segment_com(segment: Segment, name: str, height_m: float, ankle_m: float) -> np.ndarray:
     """The segment's CoM in its body frame (ORIGIN): along its axis, com of its length
-    from the first landmark. The foot's body origin is the ankle, the foot flat under it
-    from the heel (under the ankle) forward: its CoM com of its length ahead, on the floor
-    line's height above it (the ankle's height, ankle_height_fraction). m."""
+    from the first landmark. The foot's body origin is the ankle (ankle_m above the
+    floor), the foot flat under it from the heel (under the ankle) forward: its CoM com
+    of its length ahead, on the floor. m."""
     length = segment.length * height_m
     if name == "foot":
-        return np.array([segment.com * length, 0.0, -ankle_height_fraction() * height_m])
+        return np.array([segment.com * length, 0.0, -ankle_m])
     first, direction = ORIGIN[name]
     along = segment.com if first else 1.0 - segment.com
     return np.array([0.0, 0.0, direction * along * length])
 
 
-def segment_inertia(segment: Segment, name: str, height_m: float, mass_kg: float):
+def segment_inertia(
+    segment: Segment, name: str, height_m: float, mass_kg: float, ankle_m: float
+) -> SpatialInertia:
     """SpatialInertia about the body origin: the table's mass, the CoM of segment_com, and
     the radii of gyration about the CoM on the axes (sagittal x, transverse y,
     longitudinal z; the foot's longitudinal axis is x, its sagittal z)."""
@@ -163,7 +165,8 @@ def segment_inertia(segment: Segment, name: str, height_m: float, mass_kg: float
     r = np.asarray(segment.radii) * length
     moments = (r[2], r[1], r[0]) if name == "foot" else tuple(r)
     I_com = RotationalInertia(*(mass * k**2 for k in moments))
-    return SpatialInertia.MakeFromCentralInertia(mass, segment_com(segment, name, height_m), I_com)
+    p_com = segment_com(segment, name, height_m, ankle_m)
+    return SpatialInertia.MakeFromCentralInertia(mass, p_com, I_com)
 
 
 class _Builder:
@@ -172,10 +175,11 @@ class _Builder:
     def __init__(self, plant: MultibodyPlant, instance, table, height_m, mass_kg):
         self.plant, self.instance, self.table = plant, instance, table
         self.H, self.M = height_m, mass_kg
+        self.ankle_m = ankle_height_fraction(table) * height_m
         self.joints: list[str] = []
 
     def segment(self, key: str, name: str) -> RigidBody:
-        inertia = segment_inertia(self.table[name], name, self.H, self.M)
+        inertia = segment_inertia(self.table[name], name, self.H, self.M, self.ankle_m)
         return self.plant.AddRigidBody(key, self.instance, inertia)
 
     def frame(self, name: str, body: RigidBody, p: list[float]) -> Frame:
