@@ -15,6 +15,7 @@ import yaml
 from pydrake.common.yaml import yaml_dump_typed
 from pydrake.systems.analysis import GetIntegrationSchemes
 
+from drake_standup.config.body import TONES
 from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig
 from drake_standup.config.controller import QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
@@ -61,7 +62,11 @@ PLANT_STEP = Range(
 # patterns separated by spaces, '*' standing for any part of a name and '[*]' for any list
 # index. Checked in this order (tests/test_config.py: every pattern names a key).
 RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
-    (("scripted", "reactive"), "human.mode"),
+    (("scripted", "reactive", "body"), "human.mode"),
+    (TONES, "human.body.tone"),
+    # An adult the anthropometric table scales to (issue 32). m, kg.
+    (Range(low=1.5, high=1.95), "human.body.height_m"),
+    (Range(low=45.0, high=110.0), "human.body.mass_kg"),
     (("left", "right"), "human.pulls[*].hand"),
     (("velocity", "path"), "human.reactive.guide"),
     (("tangent", "interaction"), "advancement.law"),
@@ -81,6 +86,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "duration_s log_period_s controller_period_s simulator.max_step_size "
         "robot.effort_limit_Nm robot.visual_max_faces visualization.*period_s "
         "human.pulls[*].duration_s human.reactive.duration_s human.reactive.force_cap_N "
+        "human.body.grip_* "
         "human.reactive.pace_mps advancement.eps advancement.psi_ddot_filter_s "
         "advancement.full_help_pull_N "
         "phases.*.segment_psi phases.*.com_height_m standup.update_period_s "

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import SimulatorConfig
 
+from drake_standup.config.body import BodyHelperConfig
 from drake_standup.config.chair import ChairConfig, InitialPose
 from drake_standup.config.controller import ControllerConfig
 from drake_standup.config.phases import PhaseTable
@@ -128,11 +129,13 @@ class ReactiveHumanConfig:
 
 @dataclass
 class HumanConfig:
-    # scripted: the pulls below; reactive: the impedance helper (reactive:).
+    # scripted: the pulls below; reactive: the impedance helper (reactive:); body: a
+    # person's body pulling with reactive:'s intent (body:, world/helper_body.py).
     mode: str = "scripted"
     # Empty list: nobody helps.
     pulls: list[Pull] = field(default_factory=list)
     reactive: ReactiveHumanConfig = field(default_factory=ReactiveHumanConfig)
+    body: BodyHelperConfig = field(default_factory=BodyHelperConfig)
 
 
 @dataclass

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from drake_standup.outputs.helper_costs import helper_body_metrics
 from drake_standup.outputs.signals import group_normal_forces
 from drake_standup.world.human import HELPER_SPENT
 
@@ -304,6 +305,8 @@ def run_metrics(
                 signals["time_s"], signals["hand_wrenches_W"], signals["hand_velocities_W"]
             )
         )
+    if "helper_joint_torques_Nm" in signals:  # the helper's body (human.mode: body)
+        metrics.update(helper_body_metrics(signals))
     if "com_reference_W" in signals:
         metrics["path_deviation_max_m"] = path_deviation_max_m(
             signals["com_W"], signals["com_reference_W"]

@@ -16,6 +16,7 @@ from drake_standup.config import RESPONSES
 from drake_standup.control.contacts import CONTACTS
 from drake_standup.control.controller import DIAGNOSTICS
 from drake_standup.ports.payloads import COM_REFERENCE, SEGMENT
+from drake_standup.world.helper_body import state_order
 from drake_standup.world.human import HELPER_SPENT
 
 # Version of signals.npz's layout; bump it (and keep load_signals reading the
@@ -114,7 +115,27 @@ def _station_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarr
     if "helper_spent" in logs:  # human.HelperWork's running totals, on the plant's steps
         for k, name in enumerate(HELPER_SPENT):
             signals[name] = logs["helper_spent"][:, k]
+    if "helper_torques_Nm" in logs:  # the helper's body (human.mode: body)
+        signals |= _helper_body_signals(station, logs)
     return signals
+
+
+def _helper_body_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The person's joints (helper_body.py), each in their joint_names' order: angles,
+    rates and the torques their muscles applied; their grips' wrenches and their intent."""
+    helper = station.scene.helper
+    order = state_order(station.plant, helper)
+    n = len(order)
+    state = logs["helper_state"]
+    return {
+        "helper_joint_names": np.array(helper.person.joint_names, dtype=str),
+        "helper_effort_limits_Nm": helper.effort_limits_Nm,
+        "helper_joint_positions_rad": state[:, order],
+        "helper_joint_velocities_rad_per_s": state[:, n + order],
+        "helper_joint_torques_Nm": logs["helper_torques_Nm"],
+        "helper_grip_wrenches_W": logs["helper_grip_wrenches_W"],
+        "helper_intent_wrenches_W": logs["helper_intent_wrenches_W"],
+    }
 
 
 def _controller_signals(logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

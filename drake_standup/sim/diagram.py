@@ -21,6 +21,7 @@ from drake_standup.robot.icub import actuated_joints
 from drake_standup.sim.visuals import StandupVisuals
 from drake_standup.standup.plan import StandupPlan, feet_reach, make_plan
 from drake_standup.standup.standup_controller import StandupController, make_standup_controller
+from drake_standup.world.helper_control import make_body_helper
 from drake_standup.world.human import HelperWork, HumanWrenchSource
 from drake_standup.world.scene import Scene, set_seated_state
 from drake_standup.world.station import Station, make_station
@@ -132,9 +133,16 @@ def _add_station_and_human(
     """The station, the human pulling at its hands and what the helper spends, wired;
     returns the station's and the human's systems and their outputs to export by name."""
     world = builder.AddNamedSystem("station", station.diagram)
-    human = builder.AddNamedSystem(
-        "human", (make_human or HumanWrenchSource)(station.plant, station.robot, scenario.human)
-    )
+    helper = station.scene.helper
+    if helper is not None:  # the person's body; the live page's sliders set their intent
+        intent = make_human(station.plant, station.robot, scenario.human) if make_human else None
+        human = builder.AddNamedSystem(
+            "human", make_body_helper(station.plant, station.robot, scenario.human, helper, intent)
+        )
+    else:
+        human = builder.AddNamedSystem(
+            "human", (make_human or HumanWrenchSource)(station.plant, station.robot, scenario.human)
+        )
     builder.Connect(world.GetOutputPort("robot_state"), human.GetInputPort("robot_state"))
     builder.Connect(
         human.GetOutputPort("spatial_forces"), world.GetInputPort("hand_spatial_forces")
@@ -149,6 +157,17 @@ def _add_station_and_human(
     outputs = {name: world.GetOutputPort(name) for name in STATION_SIGNALS}
     outputs["applied_hand_wrenches_W"] = human.GetOutputPort("hand_wrenches_W")
     outputs["helper_spent"] = spent.GetOutputPort("helper_spent")
+    if human.HasInputPort("person_state"):
+        for source, sink in (("person_state", "person_state"), ("plant_state", "plant_state")):
+            builder.Connect(world.GetOutputPort(source), human.GetInputPort(sink))
+        builder.Connect(
+            human.GetOutputPort("desired_state"), world.GetInputPort("person_desired_state")
+        )
+        builder.Connect(human.GetOutputPort("feedforward"), world.GetInputPort("person_actuation"))
+        outputs["helper_torques_Nm"] = world.GetOutputPort("helper_torques_Nm")
+        outputs["helper_state"] = world.GetOutputPort("person_state")
+        outputs["helper_grip_wrenches_W"] = human.GetOutputPort("grip_wrenches_W")
+        outputs["helper_intent_wrenches_W"] = human.GetOutputPort("intent_wrenches_W")
     if station.diagram.HasOutputPort("push_force_W"):
         outputs["push_force_W"] = world.GetOutputPort("push_force_W")
     return world, human, outputs

@@ -115,7 +115,9 @@ def make_standup_controller(
     scenario: Scenario, station: Station, plan: StandupPlan
 ) -> StandupController:
     """The diagram of the module docstring for the station's robot and its plan."""
-    plant, robot = station.plant, station.robot
+    # The robot's own model: a helper's body is no part of it (scene.alone).
+    scene = station.scene.alone or station.scene
+    plant, robot = scene.plant, scene.robot
     config, period_s = scenario.controller, scenario.controller_period_s
     table = plan.table
     g = -plant.gravity_field().gravity_vector()[2]

@@ -12,7 +12,10 @@ In one process, --repeat times each:
   (c) closed_loop: the same without the recording;
   (d) run_diagram: `drake-standup run` (what `python run_diagram.py` runs) as a user
       runs it, once, in a fresh process: imports, both simulations (the psi = t one
-      beside the main one), the recording and every output; --no-run-diagram skips it.
+      beside the main one), the recording and every output; --no-run-diagram skips it;
+  (e) with --against NAME: (c) of another scenario, as long, interleaved with (c) run by
+      run (the machine's load shared alike), and the ratio of their speeds (e.g. the
+      person's body against the scripted helper: --scenario body --against assisted).
 Then the controller's tick split (WholeBodyController.timing_s()) and its share of
 the closed loop's wall time, the plant step timed one step at a time, the model
 build with a cold and a warm mesh cache, peak memory and the machine. One JSON
@@ -163,6 +166,10 @@ def _parser(prog: str) -> argparse.ArgumentParser:
     parser.add_argument(
         "--no-run-diagram", action="store_true", help="skip (d), the whole run_diagram.py"
     )
+    parser.add_argument(
+        "--against",
+        help="(e): a scenario to time (c) against, as --scenario names one (default: none)",
+    )
     parser.add_argument("--out", type=Path, help="also write the JSON summary to this file")
     parser.add_argument(
         "--profile",
@@ -207,14 +214,26 @@ def _measure(args: argparse.Namespace, scenario: Scenario, plant_scenario: Scena
         record=True,
         outputs=True,
     )
-    c = timed_runs(
-        scenario,
-        "(c) closed_loop",
-        args.repeat,
-        controller="whole_body",
-        record=False,
-        outputs=True,
-    )
+    c, e = [], []
+    against = _against(args, scenario)
+    for k in range(args.repeat):  # (c) and (e) alternate, so both see the same load
+        c += timed_runs(
+            scenario,
+            f"(c) closed_loop {k + 1}",
+            1,
+            controller="whole_body",
+            record=False,
+            outputs=True,
+        )
+        if against is not None:
+            e += timed_runs(
+                against,
+                f"(e) against {k + 1}",
+                1,
+                controller="whole_body",
+                record=False,
+                outputs=True,
+            )
     profile = profile_closed_loop(scenario, args.profile) if args.profile is not None else None
     run_diagram = None if args.no_run_diagram else time_run_diagram(args.scenario)
     return {
@@ -223,8 +242,29 @@ def _measure(args: argparse.Namespace, scenario: Scenario, plant_scenario: Scena
         "a": a,
         "b": b,
         "c": c,
+        "e": e,
         "profile": profile,
         "run_diagram": run_diagram,
+    }
+
+
+def _against(args: argparse.Namespace, scenario: Scenario) -> Scenario | None:
+    """--against's scenario, as long as the benchmarked one; None without it."""
+    if args.against is None:
+        return None
+    against = load_scenario(args.against)
+    against.duration_s = scenario.duration_s
+    return against
+
+
+def _against_report(args: argparse.Namespace, e: list[RunResult], closed_loop: float) -> dict:
+    """(e)'s runs and how much slower (c) simulates than they do (1.3: 30 % slower)."""
+    if not e:
+        return {}
+    against = _summary(e, closed_loop=True)
+    return {
+        "against": {"scenario": str(args.against), "closed_loop": against},
+        "ratio_against_to_closed_loop": against["sim_s_per_wall_s"]["median"] / closed_loop,
     }
 
 
@@ -255,6 +295,7 @@ def _report(
         "ratio_closed_loop_recording_to_closed_loop": (
             median["closed_loop_recording"] / median["closed_loop"]
         ),
+        **_against_report(args, measured["e"], median["closed_loop"]),
         "controller_tick": {"closed_loop": _tick_split(c), "closed_loop_recording": _tick_split(b)},
         "controller_share": {
             "closed_loop": _tick_share(c, scenario),

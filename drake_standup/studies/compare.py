@@ -11,7 +11,8 @@ is saved at once under OUT/runs/, and a comparison started again skips what it f
 
 Writes OUT/results.csv (a row per helper and response: helper, response, then every
 metric), OUT/results.md (the table a reader looks at: stand-up time, how much sooner than
-stiff, what the helper spent, how far the CoM strayed from its path) and
+stiff, what the helper spent, how far the CoM strayed from its path and, where a person's
+body helps, their peak shoulder and lumbar torques and joint effort) and
 OUT/comparison.png (the same four quantities per helper and response).
 """
 
@@ -26,11 +27,12 @@ from pathlib import Path
 from drake_standup.config.arguments import OneLineErrorParser, positive_int
 from drake_standup.studies.sweep_table import finite_number
 
-# The scripted pull, the reactive partner, the lateral and the hindering pull, and four
-# random helpers of the helpers campaign (issue 23).
+# The scripted pull, the reactive partner, the person's body (issue 32), the lateral and
+# the hindering pull, and four random helpers of the helpers campaign (issue 23).
 DEFAULT_HELPERS = (
     "assisted",
     "reactive",
+    "body",
     "lateral",
     "hindering",
     "helpers#0",
@@ -195,8 +197,9 @@ def markdown(records: list[dict]) -> str:
     restart)."""
     head = "| helper | response | stood up | stand-up time (s) | sooner than stiff |"
     head += " waited (s) | helper work (J) | positive work (J) | peak hand force (N) |"
-    head += " impulse (N s) | path deviation (cm) |"
-    lines = [head, "|" + "---|" * 11]
+    head += " impulse (N s) | path deviation (cm) | person's peak shoulder (N m) |"
+    head += " person's peak lumbar (N m) | person's effort (N^2 m^2 s) |"
+    lines = [head, "|" + "---|" * 14]
 
     def cell(value, fmt: str, scale: float = 1.0) -> str:
         number = finite_number(value)
@@ -214,7 +217,10 @@ def markdown(records: list[dict]) -> str:
                 f"{cell(m.get('helper_positive_work_J'), '.1f')} | "
                 f"{cell(m.get('helper_peak_force_N'), '.1f')} | "
                 f"{cell(m.get('helper_impulse_Ns'), '.0f')} | "
-                f"{cell(m.get('path_deviation_max_m'), '.1f', 100.0)} |"
+                f"{cell(m.get('path_deviation_max_m'), '.1f', 100.0)} | "
+                f"{cell(m.get('helper_peak_shoulder_torque_Nm'), '.1f')} | "
+                f"{cell(m.get('helper_peak_lumbar_torque_Nm'), '.0f')} | "
+                f"{cell(m.get('helper_effort_Nm2s'), '.0f')} |"
             )
     return "\n".join(lines) + "\n"
 
@@ -286,8 +292,23 @@ def summary(records: list[dict]) -> list[str]:
             sooner = sooner_than_stiff(responses["advancement"], responses.get("stiff"))
             if sooner is not None:
                 line += f"; advancement {round(100 * sooner)} % sooner than stiff"
+        spares = spares_most(responses)
+        if spares is not None:
+            line += f"; spares the person most: {spares}"
         lines.append(line)
     return lines
+
+
+def spares_most(responses: dict[str, dict]) -> str | None:
+    """Of the responses that stood up with a person's body helping, the one that cost the
+    person the least joint effort (helper_effort_Nm2s); None without a body."""
+    efforts = {
+        response: finite_number(m.get("helper_effort_Nm2s"))
+        for response, m in responses.items()
+        if m.get("success")
+    }
+    efforts = {response: e for response, e in efforts.items() if e is not None}
+    return min(efforts, key=efforts.get) if efforts else None
 
 
 def main(

@@ -30,7 +30,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.math import RigidTransform
+from pydrake.geometry import Box, Capsule, Sphere
+from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import (
     FixedOffsetFrame,
@@ -207,6 +208,14 @@ class _Builder:
         return self.table[name].length * self.H
 
 
+def omph_height(height_m: float, kneeling: bool, table: dict[str, Segment] = DE_LEVA_MALE):
+    """The lumbar joint's (OMPH's) height above the floor, standing or kneeling (the
+    shanks flat on the floor behind the knees, the knee as high as a standing ankle: the
+    same tissue under the joint, an assumption). m."""
+    z = landmark_heights(height_m, table)["OMPH"]
+    return z - table["shank"].length * height_m if kneeling else z
+
+
 def add_person(
     plant: MultibodyPlant,
     height_m: float = 1.75,
@@ -214,22 +223,34 @@ def add_person(
     X_WP: RigidTransform | None = None,
     name: str = "person",
     table: dict[str, Segment] = DE_LEVA_MALE,
+    kneeling: bool = False,
 ) -> Person:
-    """The module docstring's body, scaled to height_m and mass_kg, standing at X_WP (its
-    frame P on the floor under the mid-hip, x forward)."""
+    """The module docstring's body, scaled to height_m and mass_kg, standing (or kneeling,
+    omph_height) at X_WP (its frame P on the floor under the mid-hip, x forward); with
+    simple shapes to see where the plant has a scene graph."""
     instance = plant.AddModelInstance(name)
     b = _Builder(plant, instance, table, height_m, mass_kg)
-    z = landmark_heights(height_m, table)
     H = height_m
     lower = b.segment("lower_trunk", "lower_trunk")
-    X_WO = (X_WP or RigidTransform()) @ RigidTransform([0.0, 0.0, z["OMPH"]])
+    X_WO = (X_WP or RigidTransform()) @ RigidTransform([0.0, 0.0, omph_height(H, kneeling, table)])
     plant.WeldFrames(plant.world_frame(), lower.body_frame(), X_WO)
+    # Kneeling, the shank points backward from the knee (-z of its frame to -x) and the
+    # foot stays level under its end.
+    back = RotationMatrix.MakeYRotation(np.pi / 2 if kneeling else 0.0)
     for side, sign in (("left", 1.0), ("right", -1.0)):
         thigh = b.segment(f"{side}_thigh", "thigh")
         b.weld(lower, thigh, [0.0, sign * HIP_HALF_WIDTH * H, -b.length("lower_trunk")])
         shank = b.segment(f"{side}_shank", "shank")
-        b.weld(thigh, shank, [0.0, 0.0, -b.length("thigh")])
-        b.weld(shank, b.segment(f"{side}_foot", "foot"), [0.0, 0.0, -b.length("shank")])
+        plant.WeldFrames(
+            thigh.body_frame(),
+            shank.body_frame(),
+            RigidTransform(back, [0.0, 0.0, -b.length("thigh")]),
+        )
+        plant.WeldFrames(
+            shank.body_frame(),
+            b.segment(f"{side}_foot", "foot").body_frame(),
+            RigidTransform(back.inverse(), [0.0, 0.0, -b.length("shank")]),
+        )
     middle = b.segment("middle_trunk", "middle_trunk")
     b.chain("", lower, [0.0, 0.0, 0.0], LUMBAR_JOINTS, middle)
     upper = b.segment("upper_trunk", "upper_trunk")
@@ -246,4 +267,46 @@ def add_person(
         hand = b.segment(f"{side}_hand", "hand")
         b.chain(f"{side}_", forearm, [0.0, 0.0, -b.length("forearm")], WRIST, hand)
         b.frame(f"{side}_grip", hand, [0.0, 0.0, -b.length("hand")])
+    if plant.geometry_source_is_registered():
+        _add_shapes(plant, instance, table, H)
     return Person(instance, height_m, mass_kg, b.joints)
+
+
+# What the person looks like: (segment, its width across, its depth), fractions of stature
+# (simple shapes sized by eye on the proportions; only seen, they touch nothing).
+SHAPES = {
+    "head": (0.055, 0.06),
+    "upper_trunk": (0.17, 0.07),
+    "middle_trunk": (0.15, 0.07),
+    "lower_trunk": (0.16, 0.07),
+    "upper_arm": (0.022, 0.022),
+    "forearm": (0.018, 0.018),
+    "hand": (0.015, 0.015),
+    "thigh": (0.035, 0.035),
+    "shank": (0.027, 0.027),
+    "foot": (0.025, 0.02),
+}
+SKIN = np.array([0.85, 0.66, 0.52, 1.0])
+
+
+def _add_shapes(plant: MultibodyPlant, instance, table, height_m: float) -> None:
+    """A box per trunk segment, a sphere for the head, a capsule along each limb."""
+    for body_index in plant.GetBodyIndices(instance):
+        body = plant.get_body(body_index)
+        name = next((k for k in SHAPES if body.name().endswith(k)), None)
+        if name is None:
+            continue
+        length = table[name].length * height_m
+        width, depth = (f * height_m for f in SHAPES[name])
+        if name == "foot":
+            shape, X = Box(length, 2 * width, depth), [0.5 * length, 0.0, -0.6 * depth]
+        elif name == "head":
+            shape, X = Sphere(0.5 * length * 0.85), [0.0, 0.0, 0.5 * length]
+        else:
+            first, direction = ORIGIN[name]
+            centre = [0.0, 0.0, 0.5 * direction * length]
+            if name.endswith("trunk"):
+                shape, X = Box(depth * 2, width, length), centre
+            else:
+                shape, X = Capsule(width, max(length - 2 * width, 1e-3)), centre
+        plant.RegisterVisualGeometry(body, RigidTransform(X), shape, f"{body.name()}_shape", SKIN)

@@ -3,6 +3,7 @@ and a floor, hydroelastic contact, and the robot's seated initial state."""
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass
 
@@ -19,6 +20,7 @@ from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
 from drake_standup.world.chair import chair_sdf
+from drake_standup.world.helper_body import GRIPS, HelperBody, add_helper_body
 from drake_standup.world.perturbations import scale_friction
 from drake_standup.world.seating import SeatedPose, seated_pose
 
@@ -41,6 +43,11 @@ class Scene:
     robot: Robot
     # The robot on its chair at t = 0 (world/seating.py).
     seated: SeatedPose
+    # The helper's body (human.mode: body, world/helper_body.py), or None.
+    helper: HelperBody | None = None
+    # With a helper's body: the same scene without it (the robot's own model, for the
+    # controller: it needs every other model welded), else None.
+    alone: Scene | None = None
 
 
 def add_scene(
@@ -78,6 +85,10 @@ def add_scene(
         plant.GetFrameByName("chair", chair),
         RigidTransform(scenario.chair.xyz_m),
     )
+    helper = alone = None
+    if scenario.human.mode == "body":  # the person holds the hands where the robot sits
+        alone = _scene_alone(scenario)
+        helper = add_helper_body(plant, scenario.human.body, seated_hands_W(alone))
     plant.Finalize()
     seated = seated_pose(plant, robot, scenario)
     # Model error of perturbation.friction_scale: every surface, in the model.
@@ -89,7 +100,25 @@ def add_scene(
     scene_graph.collision_filter_manager().Apply(
         CollisionFilterDeclaration().ExcludeWithin(robot_geometries)
     )
-    return Scene(plant, scene_graph, robot, seated)
+    return Scene(plant, scene_graph, robot, seated, helper, alone)
+
+
+def _scene_alone(scenario: Scenario) -> Scene:
+    """The scenario's scene without the helper's body, nor visuals."""
+    alone = dataclasses.replace(
+        scenario, human=dataclasses.replace(scenario.human, mode="scripted")
+    )
+    return add_scene(DiagramBuilder(), alone, visuals=False)
+
+
+def seated_hands_W(scene: Scene) -> np.ndarray:
+    """(2, 3) the robot's l_hand and r_hand frames' origins as it sits in scene (the
+    helper's body is placed from them before the plant is built)."""
+    context = scene.plant.CreateDefaultContext()
+    set_seated_state(scene, context)
+    return np.array(
+        [scene.robot.frame(scene.plant, h).CalcPoseInWorld(context).translation() for h in GRIPS]
+    )
 
 
 def set_seated_state(scene: Scene, plant_context: Context) -> None:
@@ -100,6 +129,11 @@ def set_seated_state(scene: Scene, plant_context: Context) -> None:
     root = plant.GetBodyByName("root_link", instance)
     plant.SetFreeBodyPose(plant_context, root, scene.seated.base)
     plant.SetVelocities(plant_context, instance, 0.0 * plant.GetVelocities(plant_context, instance))
+    if scene.helper is not None:
+        person = scene.helper.person.model_instance
+        for name, angle in scene.helper.q0.items():
+            plant.GetJointByName(name, person).set_angle(plant_context, angle)
+        plant.SetVelocities(plant_context, person, np.zeros(plant.num_velocities(person)))
 
 
 def _standing_context(scene: Scene, scenario: Scenario, posture_rad: dict[str, float]):

@@ -123,10 +123,23 @@ def make_station(
     builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
     builder.ExportOutput(scene.scene_graph.get_query_output_port(), "query_object")
     builder.ExportOutput(reporter.get_output_port(), "pad_forces_W")
+    if scene.helper is not None:
+        _export_helper_ports(builder, plant, scene.helper.person.model_instance)
     diagram = builder.Build()
     diagram.set_name("station")
     joints = actuated_joints(plant, instance)
     return Station(diagram, scene, pad_groups, joints, standing, braced, max(drop, 0.0), arms)
+
+
+def _export_helper_ports(builder: DiagramBuilder, plant: MultibodyPlant, person) -> None:
+    """The helper's body's ports (human.mode: body): their state and the whole plant's
+    (the grips read both hands), their muscles' PD set-point and feed-forward, and the
+    torque their joints apply (Drake's PD and feed-forward, clamped to their strength)."""
+    builder.ExportOutput(plant.get_state_output_port(person), "person_state")
+    builder.ExportOutput(plant.get_state_output_port(), "plant_state")
+    builder.ExportInput(plant.get_desired_state_input_port(person), "person_desired_state")
+    builder.ExportInput(plant.get_actuation_input_port(person), "person_actuation")
+    builder.ExportOutput(plant.get_net_actuation_output_port(person), "helper_torques_Nm")
 
 
 def _add_pad_forces(

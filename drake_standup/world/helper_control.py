@@ -1,0 +1,350 @@
+"""The helper body's systems (human.mode: body; the body itself: helper_body.py).
+
+- intent: human.reactive's partner (human.py, HumanWrenchSource): the pull each hand is
+  meant to get, decided on what the person saw reaction_time_s ago.
+- PersonController, the person's muscles. Feed-forward: their own weight held and the
+  intended pull pushed through their arms, u_ff = -g(q) + sum_i J_i(q)^T f_i. Impedance:
+  Drake's implicit joint PD toward a set-point that follows their posture with a time
+  constant T (helper_body.YIELD_TIME_S, how soon they give way; dq_d/dt = v_d =
+  (q - q_d) / T): a spring in series with a damper K T, passive, so it cannot ring.
+  The trunk is not dragged along but moves on its own: its flexion's set-point is the
+  bend it takes to hold hands as high as they started plus the robot's CoM rise as the
+  person saw it reaction_time_s ago, carried on at the rate seen (helper_body.bend_for):
+  they straighten, leaning back, as the robot comes up, as far as the pull they feel
+  allows (fully up to the intent's cap, not at all from twice it). They let go (the
+  grip fades, never taken again) as the intent eases off, while the robot's CoM rises
+  through ease_com_rise_m as they saw it, or over ramp_s once the pull's time is over.
+  The plant clamps each joint's sum to its strength.
+  What failed, measured (docs/design.md): a set-point at the posture felt T ago carried
+  on at the velocity felt (rang to 190 N in 1.3 s); a trunk following what moved it (a
+  130 N m s/rad damper holding the rising robot down with 30 N); a trunk set by the
+  hands' height seen, which it lifts itself (ran away to upright in 0.4 s); arms set to
+  where the robot's hands were seen (yanked at 70 N).
+- Grips: the hands' spring-damper (helper_body.py), on the robot's hands and on the
+  person's, what the robot's wrist sensors read.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.common.value import Value
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
+from pydrake.multibody.tree import JacobianWrtVariable
+from pydrake.systems.framework import (
+    BasicVector,
+    Context,
+    Diagram,
+    DiagramBuilder,
+    LeafSystem,
+)
+
+from drake_standup.config import HumanConfig, ReactiveHumanConfig
+from drake_standup.ports.caching import declare_cached
+from drake_standup.robot.icub import Robot
+from drake_standup.world.helper_body import (
+    GRIPS,
+    YIELD_TIME_S,
+    HelperBody,
+    bend_for,
+    grip_frames,
+    instance_joint_names,
+    joint_names,
+    person_model,
+)
+from drake_standup.world.human import PERCEPTION_PERIOD_S, HumanWrenchSource
+
+# What the person perceives each update: the robot's CoM height and rate, and the larger
+# of the pulls they feel in their hands.
+_SEEN = 3
+
+
+class PersonController(LeafSystem):
+    """The person's muscles (module docstring). Inputs person_state (2n, the plant's
+    order for the person's instance), robot_state (what they see of the robot: its CoM)
+    and intent_wrenches_W (12, [0, f_l, 0, f_r]: the pull meant for the robot's l_hand
+    and r_hand). Outputs desired_state (2n) and feedforward (n), actuator order."""
+
+    def __init__(
+        self, plant: MultibodyPlant, robot: Robot, helper: HelperBody, reactive: ReactiveHumanConfig
+    ):
+        super().__init__()
+        self._plant, self._robot_instance = plant, robot.model_instance
+        self._plant_context = plant.CreateDefaultContext()
+        self._hands = [robot.frame(plant, hand) for hand in GRIPS]
+        self._height_m = helper.config.height_m
+        self._model = person_model(helper.config, helper.X_WP)
+        self._context = self._model.CreateDefaultContext()
+        self._frames = grip_frames(self._model)
+        names = joint_names(self._model)
+        n = self._n = len(names)
+        in_plant = instance_joint_names(plant, helper.person.model_instance)
+        self._from_plant = np.array([in_plant.index(name) for name in names])
+        self._to_actuators = np.array([names.index(name) for name in helper.person.joint_names])
+        self._lumbar = names.index("lumbar_flexion")
+        self._bend0 = helper.q0["lumbar_flexion"]
+        # The set-point's time constant and its step toward the posture per update.
+        self._yield_s = YIELD_TIME_S[helper.config.tone]
+        self._follow = min(1.0, PERCEPTION_PERIOD_S / self._yield_s)
+        # When they let go: as the intent eases off (the robot's CoM rising through
+        # ease_com_rise_m as they saw it), or over ramp_s once the pull's time is over.
+        self._ease_m = reactive.ease_com_rise_m
+        self._pull_end_s = reactive.start_s + reactive.duration_s
+        self._release_step = min(1.0, PERCEPTION_PERIOD_S / max(reactive.ramp_s, 1e-9))
+        # What they saw and felt: one sample (_SEEN) per update over their reaction time,
+        # oldest first. They straighten only as far as the pull they feel allows: fully
+        # up to their intent's cap, not at all from twice it (a strong person's trunk
+        # straightening at its set-point pulled 54 N and toppled the robot forward).
+        self._cap_N = reactive.force_cap_N
+        self._slots = round(reactive.reaction_time_s / PERCEPTION_PERIOD_S)
+        self._state = self.DeclareVectorInputPort("person_state", 2 * n)
+        self._robot_state = self.DeclareVectorInputPort(
+            "robot_state", plant.num_multibody_states(robot.model_instance)
+        )
+        self._intent = self.DeclareVectorInputPort("intent_wrenches_W", 12)
+        self._felt = self.DeclareVectorInputPort("grip_wrenches_W", 12)
+        self._seen = self.DeclareDiscreteState(_SEEN * (self._slots + 1))
+        self._command = self.DeclareDiscreteState(3 * n + 1)
+        self.DeclarePeriodicDiscreteUpdateEvent(PERCEPTION_PERIOD_S, 0.0, self._Update)
+        self.DeclareInitializationDiscreteUpdateEvent(self._Start)
+        ticket = {self.discrete_state_ticket(self._command)}
+        self.DeclareVectorOutputPort(
+            "desired_state", 2 * n, self._CalcDesired, prerequisites_of_calc=ticket
+        )
+        self.DeclareVectorOutputPort(
+            "feedforward", n, self._CalcFeedforward, prerequisites_of_calc=ticket
+        )
+        self.DeclareVectorOutputPort(
+            "grip",
+            1,
+            lambda c, out: out.SetAtIndex(0, c.get_discrete_state(self._command).value()[-1]),
+            prerequisites_of_calc=ticket,
+        )
+
+    def _posture(self, context: Context) -> np.ndarray:
+        """The person's joint angles now, model order."""
+        return self._state.Eval(context)[: self._n][self._from_plant]
+
+    def _look(self, context: Context) -> np.ndarray:
+        """(_SEEN,) [z, dz/dt, |f|]: the robot's CoM height and its rate, and the larger
+        grip force on their hands, now."""
+        plant, c, instances = self._plant, self._plant_context, [self._robot_instance]
+        plant.SetPositionsAndVelocities(c, self._robot_instance, self._robot_state.Eval(context))
+        z = plant.CalcCenterOfMassPositionInWorld(c, instances)[2]
+        rate = plant.CalcCenterOfMassTranslationalVelocityInWorld(c, instances)[2]
+        felt = self._felt.Eval(context).reshape(2, 6)[:, 3:]
+        return np.array([z, rate, np.linalg.norm(felt, axis=1).max()])
+
+    def _Start(self, context: Context, discrete_state) -> None:
+        q = self._posture(context)
+        seen = self._look(context)
+        c = self._plant_context  # the hands where they start (set by _look)
+        self._hands_z0 = np.mean([f.CalcPoseInWorld(c).translation()[2] for f in self._hands])
+        self._com_z0 = seen[0]
+        discrete_state.set_value(self._seen, np.tile(seen, self._slots + 1))
+        discrete_state.set_value(self._command, self._command_from(context, q, q, 1.0))
+
+    def _Update(self, context: Context, discrete_state) -> None:
+        q = self._posture(context)
+        seen = discrete_state.get_mutable_value(self._seen)
+        seen[:-_SEEN] = seen[_SEEN:].copy()
+        seen[-_SEEN:] = self._look(context)
+        command = context.get_discrete_state(self._command).value()
+        q_d = np.empty(self._n)
+        q_d[self._to_actuators] = command[: self._n]  # back to the model's order
+        q_d += self._follow * (q - q_d)
+        # The CoM's rise they expect now: what they saw, carried on at its rate.
+        rise = seen[0] + self._slots * PERCEPTION_PERIOD_S * seen[1] - self._com_z0
+        height = self._height_m
+        planned = (
+            self._bend0 + bend_for(height, self._hands_z0 + rise) - bend_for(height, self._hands_z0)
+        )
+        allowed = min(1.0, max(0.0, 2.0 - seen[2] / self._cap_N)) if self._cap_N > 0 else 1.0
+        q_d[self._lumbar] += allowed * (planned - q_d[self._lumbar])
+        # Their grip: held, let go of (never taken again) once the robot is up.
+        grip = command[-1]
+        if context.get_time() >= self._pull_end_s:
+            grip = max(0.0, grip - self._release_step)
+        low, high = self._ease_m
+        grip = min(grip, max(0.0, (high - rise) / (high - low)))
+        discrete_state.set_value(self._command, self._command_from(context, q, q_d, grip))
+
+    def _jacobian(self) -> np.ndarray:
+        """(6, n) the grips' translational Jacobians in the model context as set."""
+        model, c = self._model, self._context
+        world = model.world_frame()
+        return np.vstack(
+            [
+                model.CalcJacobianTranslationalVelocity(
+                    c, JacobianWrtVariable.kV, f, np.zeros(3), world, world
+                )
+                for f in self._frames
+            ]
+        )
+
+    def _command_from(
+        self, context: Context, q: np.ndarray, q_d: np.ndarray, grip: float
+    ) -> np.ndarray:
+        """[q_d, v_d, u_ff, grip]: in actuator order from the posture now (q) and the
+        set-point q_d (model order), the set-point's rate, their weight and the intended
+        pull (as far as they still hold the hands); their grip, 1 held, 0 let go."""
+        model, c = self._model, self._context
+        model.SetPositions(c, q)
+        u = -model.CalcGravityGeneralizedForces(c)
+        f = self._intent.Eval(context).reshape(2, 6)[:, 3:]
+        world = model.world_frame()
+        for frame, force in zip(self._frames, f):
+            if np.any(force):
+                J = model.CalcJacobianTranslationalVelocity(
+                    c, JacobianWrtVariable.kV, frame, np.zeros(3), world, world
+                )
+                u += grip * (J.T @ force)
+        v_d = (q - q_d) / self._yield_s
+        v_d[self._lumbar] = 0.0  # the trunk's set-point is its own (not following q)
+        order = self._to_actuators
+        return np.concatenate([q_d[order], v_d[order], u[order], [grip]])
+
+    def _CalcDesired(self, context: Context, output: BasicVector) -> None:
+        output.SetFromVector(context.get_discrete_state(self._command).value()[: 2 * self._n])
+
+    def _CalcFeedforward(self, context: Context, output: BasicVector) -> None:
+        output.SetFromVector(context.get_discrete_state(self._command).value()[2 * self._n : -1])
+
+
+class Grips(LeafSystem):
+    """The hands' spring-damper, f = k (p_grip - p_hand) + d (v_grip - v_hand) on each of
+    the robot's hands (GRIPS: l_hand, r_hand), -f on the person's grip, at the frames'
+    origins. Input plant_state (the whole plant's). Outputs spatial_forces (the plant's
+    applied forces, all four), hand_wrenches_W (12, [0, f_l, 0, f_r]: what the robot's
+    wrist sensors read) and grip_wrenches_W (12: the same on the person's grips)."""
+
+    def __init__(self, plant: MultibodyPlant, robot: Robot, helper: HelperBody):
+        super().__init__()
+        self._plant = plant
+        self._context = plant.CreateDefaultContext()
+        cfg = helper.config
+        self._k, self._d = cfg.grip_stiffness_N_per_m, cfg.grip_damping_Ns_per_m
+        instance = helper.person.model_instance
+        self._pairs = [
+            (robot.frame(plant, hand), plant.GetFrameByName(grip, instance))
+            for hand, grip in GRIPS.items()
+        ]
+        self._applied = []
+        for pair in self._pairs:
+            for frame in pair:
+                force = ExternallyAppliedSpatialForce()
+                force.body_index = frame.body().index()
+                force.p_BoBq_B = frame.GetFixedPoseInBodyFrame().translation()
+                self._applied.append(force)
+        self._x = self.DeclareVectorInputPort("plant_state", plant.num_multibody_states())
+        self._grip = self.DeclareVectorInputPort("grip", 1)
+        cache = declare_cached(
+            self, "grip forces", self._forces, {self._x.ticket(), self._grip.ticket()}
+        )
+        prereq = {cache.ticket()}
+        self._cache = cache
+        self.DeclareVectorOutputPort(
+            "hand_wrenches_W",
+            12,
+            lambda c, out: out.SetFromVector(self._wrenches(c, 1.0)),
+            prerequisites_of_calc=prereq,
+        )
+        self.DeclareVectorOutputPort(
+            "grip_wrenches_W",
+            12,
+            lambda c, out: out.SetFromVector(self._wrenches(c, -1.0)),
+            prerequisites_of_calc=prereq,
+        )
+        self.DeclareAbstractOutputPort(
+            "spatial_forces",
+            lambda: Value[list[ExternallyAppliedSpatialForce]]([]),
+            self._CalcSpatialForces,
+            prerequisites_of_calc=prereq,
+        )
+
+    def _forces(self, context: Context) -> np.ndarray:
+        """(2, 3) the grips' forces on the robot's l_hand and r_hand, world, as far as
+        the person holds them (grip input). N."""
+        held = float(self._grip.Eval(context)[0])
+        if held == 0.0:
+            return np.zeros((2, 3))
+        plant, c = self._plant, self._context
+        plant.SetPositionsAndVelocities(c, self._x.Eval(context))
+        world = plant.world_frame()
+        forces = np.zeros((2, 3))
+        for i, (hand, grip) in enumerate(self._pairs):
+            stretch = grip.CalcPoseInWorld(c).translation() - hand.CalcPoseInWorld(c).translation()
+            rate = (
+                grip.CalcSpatialVelocity(c, world, world).translational()
+                - hand.CalcSpatialVelocity(c, world, world).translational()
+            )
+            forces[i] = held * (self._k * stretch + self._d * rate)
+        return forces
+
+    def _wrenches(self, context: Context, sign: float) -> np.ndarray:
+        wrenches = np.zeros(12)
+        wrenches.reshape(2, 6)[:, 3:] = sign * self._cache.Eval(context)
+        return wrenches
+
+    def _CalcSpatialForces(self, context: Context, output) -> None:
+        forces = self._cache.Eval(context)
+        for i in range(2):
+            self._applied[2 * i].F_Bq_W = SpatialForce(np.zeros(3), forces[i])
+            self._applied[2 * i + 1].F_Bq_W = SpatialForce(np.zeros(3), -forces[i])
+        output.set_value(list(self._applied))
+
+
+# The helper body's diagram: its inputs and outputs (diagram.py wires them to the station).
+BODY_INPUTS = ("robot_state", "person_state", "plant_state")
+BODY_OUTPUTS = (
+    "spatial_forces",
+    "hand_wrenches_W",
+    "grip_wrenches_W",
+    "intent_wrenches_W",
+    "desired_state",
+    "feedforward",
+    "grip",
+)
+
+
+def make_body_helper(
+    plant: MultibodyPlant,
+    robot: Robot,
+    config: HumanConfig,
+    helper: HelperBody,
+    intent: LeafSystem | None = None,
+) -> Diagram:
+    """The person's intent, muscles and grips as one system with the ports of BODY_INPUTS
+    and BODY_OUTPUTS. intent: what they mean to pull, a system with HumanWrenchSource's
+    ports (the live page's sliders, live.py: its stand_up and response outputs are
+    exported too); default human.reactive's partner."""
+    builder = DiagramBuilder()
+    if intent is None:
+        reactive = HumanConfig(mode="reactive", reactive=config.reactive)
+        intent = HumanWrenchSource(plant, robot, reactive)
+    intent = builder.AddNamedSystem("intent", intent)
+    for name in ("stand_up", "response"):
+        if intent.HasOutputPort(name):
+            builder.ExportOutput(intent.GetOutputPort(name), name)
+    muscles = builder.AddNamedSystem(
+        "muscles", PersonController(plant, robot, helper, config.reactive)
+    )
+    grips = builder.AddNamedSystem("grips", Grips(plant, robot, helper))
+    builder.ExportInput(intent.GetInputPort("robot_state"), "robot_state")
+    builder.ConnectInput("robot_state", muscles.GetInputPort("robot_state"))
+    builder.ExportInput(muscles.GetInputPort("person_state"), "person_state")
+    builder.ExportInput(grips.GetInputPort("plant_state"), "plant_state")
+    builder.Connect(
+        intent.GetOutputPort("hand_wrenches_W"), muscles.GetInputPort("intent_wrenches_W")
+    )
+    builder.Connect(muscles.GetOutputPort("grip"), grips.GetInputPort("grip"))
+    builder.Connect(grips.GetOutputPort("grip_wrenches_W"), muscles.GetInputPort("grip_wrenches_W"))
+    for name in ("spatial_forces", "hand_wrenches_W", "grip_wrenches_W"):
+        builder.ExportOutput(grips.GetOutputPort(name), name)
+    builder.ExportOutput(intent.GetOutputPort("hand_wrenches_W"), "intent_wrenches_W")
+    builder.ExportOutput(muscles.GetOutputPort("desired_state"), "desired_state")
+    builder.ExportOutput(muscles.GetOutputPort("feedforward"), "feedforward")
+    builder.ExportOutput(muscles.GetOutputPort("grip"), "grip")
+    diagram = builder.Build()
+    diagram.set_name("helper_body")
+    return diagram
