@@ -10,8 +10,9 @@
   The trunk is not dragged along but moves on its own: its flexion's set-point is the
   bend it takes to hold hands as high as they started plus the robot's CoM rise as the
   person saw it reaction_time_s ago, carried on at the rate seen (helper_body.bend_for):
-  they straighten, leaning back, as the robot comes up, as far as the pull they feel
-  allows (fully up to the intent's cap, not at all from twice it). They let go (the
+  they straighten, leaning back, as the robot comes up. Feeling a pull beyond their
+  intent's cap (YIELD_LATENCY_S ago) they give way, wholly from twice it: the set-point
+  jumps to the posture and moves with it, and the trunk stops straightening. They let go (the
   grip fades, never taken again) as the intent eases off, while the robot's CoM rises
   through ease_com_rise_m as they saw it, or over ramp_s once the pull's time is over.
   The plant clamps each joint's sum to its strength.
@@ -57,6 +58,9 @@ from drake_standup.world.human import PERCEPTION_PERIOD_S, HumanWrenchSource
 # What the person perceives each update: the robot's CoM height and rate, and the larger
 # of the pulls they feel in their hands.
 _SEEN = 3
+# How soon they give way to a pull beyond what they mean: a long-latency stretch reflex's
+# latency (50-100 ms; a modelling choice). s.
+YIELD_LATENCY_S = 0.05
 
 
 class PersonController(LeafSystem):
@@ -92,11 +96,12 @@ class PersonController(LeafSystem):
         self._pull_end_s = reactive.start_s + reactive.duration_s
         self._release_step = min(1.0, PERCEPTION_PERIOD_S / max(reactive.ramp_s, 1e-9))
         # What they saw and felt: one sample (_SEEN) per update over their reaction time,
-        # oldest first. They straighten only as far as the pull they feel allows: fully
-        # up to their intent's cap, not at all from twice it (a strong person's trunk
-        # straightening at its set-point pulled 54 N and toppled the robot forward).
+        # oldest first. Feeling more than they mean to pull, they give way (a strong
+        # person's trunk straightening at its set-point pulled 54 N and toppled the robot
+        # forward; firm arms held its rising hands back with 83 N: measured).
         self._cap_N = reactive.force_cap_N
         self._slots = round(reactive.reaction_time_s / PERCEPTION_PERIOD_S)
+        self._yield_lag = min(round(YIELD_LATENCY_S / PERCEPTION_PERIOD_S), self._slots)
         self._state = self.DeclareVectorInputPort("person_state", 2 * n)
         self._robot_state = self.DeclareVectorInputPort(
             "robot_state", plant.num_multibody_states(robot.model_instance)
@@ -125,6 +130,10 @@ class PersonController(LeafSystem):
         """The person's joint angles now, model order."""
         return self._state.Eval(context)[: self._n][self._from_plant]
 
+    def _rates(self, context: Context) -> np.ndarray:
+        """The person's joint rates now, model order."""
+        return self._state.Eval(context)[self._n :][self._from_plant]
+
     def _look(self, context: Context) -> np.ndarray:
         """(_SEEN,) [z, dz/dt, |f|]: the robot's CoM height and its rate, and the larger
         grip force on their hands, now."""
@@ -142,7 +151,8 @@ class PersonController(LeafSystem):
         self._hands_z0 = np.mean([f.CalcPoseInWorld(c).translation()[2] for f in self._hands])
         self._com_z0 = seen[0]
         discrete_state.set_value(self._seen, np.tile(seen, self._slots + 1))
-        discrete_state.set_value(self._command, self._command_from(context, q, q, 1.0))
+        v_d = np.zeros(self._n)
+        discrete_state.set_value(self._command, self._command_from(context, q, q, v_d, 1.0))
 
     def _Update(self, context: Context, discrete_state) -> None:
         q = self._posture(context)
@@ -152,22 +162,26 @@ class PersonController(LeafSystem):
         command = context.get_discrete_state(self._command).value()
         q_d = np.empty(self._n)
         q_d[self._to_actuators] = command[: self._n]  # back to the model's order
-        q_d += self._follow * (q - q_d)
+        # They give way to a pull beyond what they mean (felt YIELD_LATENCY_S ago): not at
+        # all up to their intent's cap, wholly from twice it.
+        felt = seen[-_SEEN * (1 + self._yield_lag) + 2]
+        give = min(1.0, max(0.0, felt / self._cap_N - 1.0)) if self._cap_N > 0 else 0.0
+        q_d += (self._follow + give * (1.0 - self._follow)) * (q - q_d)
         # The CoM's rise they expect now: what they saw, carried on at its rate.
         rise = seen[0] + self._slots * PERCEPTION_PERIOD_S * seen[1] - self._com_z0
         height = self._height_m
         planned = (
             self._bend0 + bend_for(height, self._hands_z0 + rise) - bend_for(height, self._hands_z0)
         )
-        allowed = min(1.0, max(0.0, 2.0 - seen[2] / self._cap_N)) if self._cap_N > 0 else 1.0
-        q_d[self._lumbar] += allowed * (planned - q_d[self._lumbar])
+        q_d[self._lumbar] += (1.0 - give) * (planned - q_d[self._lumbar])
         # Their grip: held, let go of (never taken again) once the robot is up.
         grip = command[-1]
         if context.get_time() >= self._pull_end_s:
             grip = max(0.0, grip - self._release_step)
         low, high = self._ease_m
         grip = min(grip, max(0.0, (high - rise) / (high - low)))
-        discrete_state.set_value(self._command, self._command_from(context, q, q_d, grip))
+        v_d = (1.0 - give) * (q - q_d) / self._yield_s + give * self._rates(context)
+        discrete_state.set_value(self._command, self._command_from(context, q, q_d, v_d, grip))
 
     def _jacobian(self) -> np.ndarray:
         """(6, n) the grips' translational Jacobians in the model context as set."""
@@ -183,11 +197,11 @@ class PersonController(LeafSystem):
         )
 
     def _command_from(
-        self, context: Context, q: np.ndarray, q_d: np.ndarray, grip: float
+        self, context: Context, q: np.ndarray, q_d: np.ndarray, v_d: np.ndarray, grip: float
     ) -> np.ndarray:
-        """[q_d, v_d, u_ff, grip]: in actuator order from the posture now (q) and the
-        set-point q_d (model order), the set-point's rate, their weight and the intended
-        pull (as far as they still hold the hands); their grip, 1 held, 0 let go."""
+        """[q_d, v_d, u_ff, grip]: in actuator order the set-point and its rate (model
+        order), and from the posture now (q) their weight and the intended pull (as far as
+        they still hold the hands); their grip, 1 held, 0 let go."""
         model, c = self._model, self._context
         model.SetPositions(c, q)
         u = -model.CalcGravityGeneralizedForces(c)
@@ -199,7 +213,7 @@ class PersonController(LeafSystem):
                     c, JacobianWrtVariable.kV, frame, np.zeros(3), world, world
                 )
                 u += grip * (J.T @ force)
-        v_d = (q - q_d) / self._yield_s
+        v_d = v_d.copy()
         v_d[self._lumbar] = 0.0  # the trunk's set-point is its own (not following q)
         order = self._to_actuators
         return np.concatenate([q_d[order], v_d[order], u[order], [grip]])
