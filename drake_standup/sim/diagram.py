@@ -285,7 +285,9 @@ def add_seat_hold(builder, scene: Scene, scenario: Scenario, desired_state, actu
     plant_context = plant.CreateDefaultContext()
     set_seated_state(scene, plant_context)
     q0 = plant.GetPositions(plant_context, instance)
-    u_ff = plant.MakeActuationMatrix().T @ (-plant.CalcGravityGeneralizedForces(plant_context))
+    robot_actuators = [int(i) for i in plant.GetJointActuatorIndices(instance)]
+    B = plant.MakeActuationMatrix()[:, robot_actuators]  # a helper's body has its own
+    u_ff = B.T @ (-plant.CalcGravityGeneralizedForces(plant_context))
     q_index = actuated_joints(plant, instance).q_index
     x0 = np.concatenate([q0[q_index], np.zeros(len(q_index))])
     setpoint = builder.AddNamedSystem("seat_hold_setpoint", ConstantVectorSource(x0))

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import cProfile
+import dataclasses
 import hashlib
 import importlib.metadata
 import os
@@ -99,7 +100,11 @@ def time_plant_step(scenario: Scenario, steps: int) -> dict:
     step_s = scenario.plant.time_step
     builder = DiagramBuilder()
     hold = scenario.seat_hold
-    scene = add_scene(builder, scenario, pd_gains=(hold.kp_Nm_per_rad, hold.kd_Nms_per_rad))
+    # The bare plant is the robot's scene: a helper's body needs its controller wired.
+    alone = dataclasses.replace(
+        scenario, human=dataclasses.replace(scenario.human, mode="scripted")
+    )
+    scene = add_scene(builder, alone, pd_gains=(hold.kp_Nm_per_rad, hold.kd_Nms_per_rad))
     instance = scene.robot.model_instance
     add_seat_hold(
         builder,

@@ -21,8 +21,8 @@ revolutes) through an elbow (1) and a wrist (1). The shoulders sit at the
 suprasternale's height (170.7 mm above XYPH on 1741, de Leva), 0.1 of the stature to
 each side, and the hips 0.0461 of it (Dumas, Cheze, Verriest 2007, "Adjustments to
 McConville et al. and Young et al. body segment inertial parameters", J. Biomech.
-40(3), as the HeiMan model uses them). Not yet in the diagram: `human.mode: body`, the
-grip, the person's controller and what helping costs them are issue 32's next parts.
+40(3), as the HeiMan model uses them). human.mode: body puts this person into the
+plant (helper_body.py), kneeling: the shanks flat behind the knees.
 """
 
 from __future__ import annotations
