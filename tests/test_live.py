@@ -481,3 +481,19 @@ def test_live_bench_helper_sets_both_hands_sliders_between_chunks():
     )
     np.testing.assert_array_equal(forces[3:6], [12.0, 0.0, 6.0])
     np.testing.assert_array_equal(forces[9:12], [12.0, 0.0, 6.0])
+
+
+def test_with_a_body_the_sliders_steer_the_persons_intent():
+    """human.mode: body at the live page: the sliders set what the person means to pull
+    (the intent their muscles push through their arms), and their grips then pull the
+    robot's hands forward and up; the robot reads the grips, not the sliders."""
+    scenario = load_scenario(SCENARIO_DIR / "body.yaml")
+    scenario.standup.trigger = "time"
+    live = _Live(scenario)
+    _set_pull(live.meshcat, (15.0, 15.0))
+    live.advance(0.6)
+    intent = live.output("helper_intent_wrenches_W").reshape(2, 6)[:, 3:]
+    np.testing.assert_allclose(intent, [_world((15.0, 15.0))] * 2)
+    grip = live.measured()
+    assert np.all(grip[:, 0] > 2.0) and np.all(grip[:, 2] > 2.0), grip
+    assert not np.allclose(grip, intent)  # what the grips transmit, not the sliders
