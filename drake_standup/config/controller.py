@@ -56,29 +56,9 @@ class ControllerConfig:
     momentum_weight: float = 100.0
     # Posture weight per joint, rad/s^2: lower, the QP swung the arms onto their limits.
     posture_weight: float = 0.1
-    # ... replaced per joint: the torso holds its own against the twelve leg joints; the
-    # arms at 0.3: at 0.1 the momentum task whipped them at 4-6 rad/s as the rise began
-    # and ended, which yanked a person holding the hands with up to 110 N; at 1.0 the
-    # default run's soles chattered 44 N, at 0.3 17 N (issue 32, docs/design.md).
+    # ... replaced per joint: the torso holds its own against the twelve leg joints.
     posture_weight_by_joint: dict[str, float] = field(
-        default_factory=lambda: {
-            "torso_pitch": 1.0,
-            "torso_roll": 1.0,
-            "torso_yaw": 1.0,
-            **{
-                f"{side}_{joint}": 0.3
-                for side in "lr"
-                for joint in (
-                    "shoulder_pitch",
-                    "shoulder_roll",
-                    "shoulder_yaw",
-                    "elbow",
-                    "wrist_prosup",
-                    "wrist_pitch",
-                    "wrist_yaw",
-                )
-            },
-        }
+        default_factory=lambda: {"torso_pitch": 1.0, "torso_roll": 1.0, "torso_yaw": 1.0}
     )
     # Base orientation weight: the pelvis ends upright to 0.3 deg (1.4 deg at 1).
     base_orientation_weight: float = 10.0
