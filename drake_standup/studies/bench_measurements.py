@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import contextlib
 import cProfile
-import dataclasses
 import hashlib
 import importlib.metadata
 import os
@@ -28,7 +27,7 @@ from pydrake.systems.framework import DiagramBuilder
 from drake_standup.config import Scenario
 from drake_standup.sim.diagram import add_seat_hold, build_diagram
 from drake_standup.sim.simulate import RunResult, simulate
-from drake_standup.world.scene import add_scene, set_seated_state
+from drake_standup.world.scene import add_scene, set_seated_state, without_body
 
 PROFILE_TOP = 40  # functions listed in the profile's text summary
 
@@ -101,10 +100,8 @@ def time_plant_step(scenario: Scenario, steps: int) -> dict:
     builder = DiagramBuilder()
     hold = scenario.seat_hold
     # The bare plant is the robot's scene: a helper's body needs its controller wired.
-    alone = dataclasses.replace(
-        scenario, human=dataclasses.replace(scenario.human, mode="scripted")
-    )
-    scene = add_scene(builder, alone, pd_gains=(hold.kp_Nm_per_rad, hold.kd_Nms_per_rad))
+    pd_gains = (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad)
+    scene = add_scene(builder, without_body(scenario), pd_gains=pd_gains)
     instance = scene.robot.model_instance
     add_seat_hold(
         builder,

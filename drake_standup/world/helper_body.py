@@ -185,14 +185,27 @@ def person_model(cfg: BodyHelperConfig, X_WP: RigidTransform) -> MultibodyPlant:
 
 
 def joint_names(model: MultibodyPlant) -> list[str]:
-    """The person model's joints in the order of its positions (one each)."""
-    joints = [model.get_joint(i) for i in model.GetJointIndices()]
-    return [j.name() for j in sorted(joints, key=lambda j: j.position_start()) if j.num_positions()]
+    """The person model's (person_model's) joints in the order of its positions."""
+    return instance_joint_names(model, model.GetModelInstanceByName("person"))
 
 
 def grip_frames(model: MultibodyPlant):
     """The person's grip frames in GRIPS' order."""
     return [model.GetFrameByName(grip) for grip in GRIPS.values()]
+
+
+def grips_jacobian(
+    model: MultibodyPlant, context, wrt: JacobianWrtVariable = JacobianWrtVariable.kV
+) -> np.ndarray:
+    """(6, n) the translational Jacobians of the person's grips' origins (GRIPS' order),
+    world, in context."""
+    world = model.world_frame()
+    return np.vstack(
+        [
+            model.CalcJacobianTranslationalVelocity(context, wrt, f, np.zeros(3), world, world)
+            for f in grip_frames(model)
+        ]
+    )
 
 
 def reach(model: MultibodyPlant, bend_rad: float, targets_W: np.ndarray) -> np.ndarray:
@@ -208,21 +221,14 @@ def reach(model: MultibodyPlant, bend_rad: float, targets_W: np.ndarray) -> np.n
             kind, 0.0
         )
     elbows = [i for i, name in enumerate(names) if joint_kind(name) == "elbow"]
-    frames, world = grip_frames(model), model.world_frame()
+    frames = grip_frames(model)
     q = nominal.copy()
     for iteration in range(200):
         model.SetPositions(context, q)
         error = np.concatenate(
             [f.CalcPoseInWorld(context).translation() - p for f, p in zip(frames, targets_W)]
         )
-        J = np.vstack(
-            [
-                model.CalcJacobianTranslationalVelocity(
-                    context, JacobianWrtVariable.kQDot, f, np.zeros(3), world, world
-                )
-                for f in frames
-            ]
-        )
+        J = grips_jacobian(model, context, JacobianWrtVariable.kQDot)
         mu = 1e-3 if iteration < 150 else 1e-9
         step = np.linalg.solve(J.T @ J + mu * np.eye(len(q)), -J.T @ error - mu * (q - nominal))
         q = q + step

@@ -31,7 +31,6 @@ import numpy as np
 from pydrake.common.value import Value
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
-from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import (
     BasicVector,
     Context,
@@ -48,12 +47,12 @@ from drake_standup.world.helper_body import (
     YIELD_TIME_S,
     HelperBody,
     bend_for,
-    grip_frames,
+    grips_jacobian,
     instance_joint_names,
     joint_names,
     person_model,
 )
-from drake_standup.world.human import PERCEPTION_PERIOD_S, HumanWrenchSource
+from drake_standup.world.human import PERCEPTION_PERIOD_S, HumanWrenchSource, applied_at
 
 # What the person perceives each update: the robot's CoM height and rate, and the larger
 # of the pulls they feel in their hands.
@@ -79,7 +78,6 @@ class PersonController(LeafSystem):
         self._height_m = helper.config.height_m
         self._model = person_model(helper.config, helper.X_WP)
         self._context = self._model.CreateDefaultContext()
-        self._frames = grip_frames(self._model)
         names = joint_names(self._model)
         n = self._n = len(names)
         in_plant = instance_joint_names(plant, helper.person.model_instance)
@@ -183,19 +181,6 @@ class PersonController(LeafSystem):
         v_d = (1.0 - give) * (q - q_d) / self._yield_s + give * self._rates(context)
         discrete_state.set_value(self._command, self._command_from(context, q, q_d, v_d, grip))
 
-    def _jacobian(self) -> np.ndarray:
-        """(6, n) the grips' translational Jacobians in the model context as set."""
-        model, c = self._model, self._context
-        world = model.world_frame()
-        return np.vstack(
-            [
-                model.CalcJacobianTranslationalVelocity(
-                    c, JacobianWrtVariable.kV, f, np.zeros(3), world, world
-                )
-                for f in self._frames
-            ]
-        )
-
     def _command_from(
         self, context: Context, q: np.ndarray, q_d: np.ndarray, v_d: np.ndarray, grip: float
     ) -> np.ndarray:
@@ -206,13 +191,8 @@ class PersonController(LeafSystem):
         model.SetPositions(c, q)
         u = -model.CalcGravityGeneralizedForces(c)
         f = self._intent.Eval(context).reshape(2, 6)[:, 3:]
-        world = model.world_frame()
-        for frame, force in zip(self._frames, f):
-            if np.any(force):
-                J = model.CalcJacobianTranslationalVelocity(
-                    c, JacobianWrtVariable.kV, frame, np.zeros(3), world, world
-                )
-                u += grip * (J.T @ force)
+        if np.any(f):
+            u += grip * (grips_jacobian(model, c).T @ f.ravel())
         v_d = v_d.copy()
         v_d[self._lumbar] = 0.0  # the trunk's set-point is its own (not following q)
         order = self._to_actuators
@@ -243,13 +223,7 @@ class Grips(LeafSystem):
             (robot.frame(plant, hand), plant.GetFrameByName(grip, instance))
             for hand, grip in GRIPS.items()
         ]
-        self._applied = []
-        for pair in self._pairs:
-            for frame in pair:
-                force = ExternallyAppliedSpatialForce()
-                force.body_index = frame.body().index()
-                force.p_BoBq_B = frame.GetFixedPoseInBodyFrame().translation()
-                self._applied.append(force)
+        self._applied = [applied_at(frame) for pair in self._pairs for frame in pair]
         self._x = self.DeclareVectorInputPort("plant_state", plant.num_multibody_states())
         self._grip = self.DeclareVectorInputPort("grip", 1)
         cache = declare_cached(
@@ -308,19 +282,6 @@ class Grips(LeafSystem):
         output.set_value(list(self._applied))
 
 
-# The helper body's diagram: its inputs and outputs (diagram.py wires them to the station).
-BODY_INPUTS = ("robot_state", "person_state", "plant_state")
-BODY_OUTPUTS = (
-    "spatial_forces",
-    "hand_wrenches_W",
-    "grip_wrenches_W",
-    "intent_wrenches_W",
-    "desired_state",
-    "feedforward",
-    "grip",
-)
-
-
 def make_body_helper(
     plant: MultibodyPlant,
     robot: Robot,
@@ -328,10 +289,12 @@ def make_body_helper(
     helper: HelperBody,
     intent: LeafSystem | None = None,
 ) -> Diagram:
-    """The person's intent, muscles and grips as one system with the ports of BODY_INPUTS
-    and BODY_OUTPUTS. intent: what they mean to pull, a system with HumanWrenchSource's
-    ports (the live page's sliders, live.py: its stand_up and response outputs are
-    exported too); default human.reactive's partner."""
+    """The person's intent, muscles and grips as one system: inputs robot_state,
+    person_state and plant_state; outputs spatial_forces, hand_wrenches_W (the grips' on
+    the robot), grip_wrenches_W, intent_wrenches_W, desired_state, feedforward and grip
+    (diagram.py wires them to the station). intent: what they mean to pull, a system with
+    HumanWrenchSource's ports (the live page's sliders, live.py: its stand_up and response
+    outputs are exported too); default human.reactive's partner."""
     builder = DiagramBuilder()
     if intent is None:
         reactive = HumanConfig(mode="reactive", reactive=config.reactive)

@@ -38,17 +38,18 @@ HELPER_SPENT = (
 )
 
 
+def applied_at(frame) -> ExternallyAppliedSpatialForce:
+    """An applied force on frame's body at the frame's origin (its F_Bq_W set by the user)."""
+    force = ExternallyAppliedSpatialForce()
+    force.body_index = frame.body().index()
+    force.p_BoBq_B = frame.GetFixedPoseInBodyFrame().translation()
+    return force
+
+
 def hand_forces(plant: MultibodyPlant, robot: Robot) -> list[ExternallyAppliedSpatialForce]:
     """One applied force per hand (TASK_FRAMES), at the hand frame's origin; a human
     source sets their forces each time it outputs them (spatial_forces)."""
-    applied = []
-    for name in TASK_FRAMES:
-        frame = robot.frame(plant, name)
-        force = ExternallyAppliedSpatialForce()
-        force.body_index = frame.body().index()
-        force.p_BoBq_B = frame.GetFixedPoseInBodyFrame().translation()
-        applied.append(force)
-    return applied
+    return [applied_at(robot.frame(plant, name)) for name in TASK_FRAMES]
 
 
 def spatial_forces(

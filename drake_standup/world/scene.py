@@ -103,12 +103,14 @@ def add_scene(
     return Scene(plant, scene_graph, robot, seated, helper, alone)
 
 
+def without_body(scenario: Scenario) -> Scenario:
+    """scenario with the helper's body taken out of the plant (human.mode scripted)."""
+    return dataclasses.replace(scenario, human=dataclasses.replace(scenario.human, mode="scripted"))
+
+
 def _scene_alone(scenario: Scenario) -> Scene:
     """The scenario's scene without the helper's body, nor visuals."""
-    alone = dataclasses.replace(
-        scenario, human=dataclasses.replace(scenario.human, mode="scripted")
-    )
-    return add_scene(DiagramBuilder(), alone, visuals=False)
+    return add_scene(DiagramBuilder(), without_body(scenario), visuals=False)
 
 
 def seated_hands_W(scene: Scene) -> np.ndarray:
