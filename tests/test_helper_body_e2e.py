@@ -1,14 +1,13 @@
 """Issue 32 end to end (slow): people of 1.55 and 1.90 m, 50 and 100 kg, their arms
 relaxed or firm, stand the robot up, none falls; their logged torques never exceed
 their strength, and a relaxed person keeps strength to spare; with the default person
-advancement stands up sooner than the stiff response (issue 32 asked for 15 %: 5 % is
-what this person gives, docs/design.md)."""
+advancement stands up at least 15 % sooner than the stiff response (issue 32)."""
 
 from __future__ import annotations
 
 import pytest
 
-from drake_standup.config import SCENARIO_DIR, Scenario, load_scenario
+from drake_standup.config import SCENARIO_DIR, load_scenario
 from drake_standup.sim.simulate import simulate
 
 pytestmark = pytest.mark.slow
@@ -46,14 +45,13 @@ def test_any_person_stands_the_robot_up_within_their_strength(height_m, mass_kg,
     assert 0.0 < m["helper_peak_shoulder_torque_Nm"] and 0.0 < m["helper_peak_lumbar_torque_Nm"]
 
 
-def test_advancement_stands_up_sooner_than_stiff_with_the_default_person():
+def test_advancement_stands_up_15_percent_sooner_than_stiff_with_the_default_person():
     advancement = _metrics([])
     stiff = _metrics([("response", "stiff")])
     assert advancement["success"] and stiff["success"]
-    # Sooner by more than a few of the stand-up time's samples (10 ms): 3.51 s against
-    # 3.71 s here.
-    sample = Scenario().log_period_s
-    assert advancement["standup_time_s"] <= stiff["standup_time_s"] - 5 * sample, (
+    assert advancement["standing_at_end"] and stiff["standing_at_end"]
+    # 3.14 s against 3.71 s here (docs/design.md).
+    assert advancement["standup_time_s"] <= 0.85 * stiff["standup_time_s"], (
         advancement["standup_time_s"],
         stiff["standup_time_s"],
     )

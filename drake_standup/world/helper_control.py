@@ -7,20 +7,32 @@
   Drake's implicit joint PD toward a set-point that follows their posture with a time
   constant T (helper_body.YIELD_TIME_S, how soon they give way; dq_d/dt = v_d =
   (q - q_d) / T): a spring in series with a damper K T, passive, so it cannot ring.
+  Their arms go with the hands they hold: they feel those hands move YIELD_LATENCY_S
+  late and predict the motion now (carried on at the acceleration felt); the arms'
+  set-point moves at that velocity less what their trunk's motion already gives the
+  grips (least squares through the arms' Jacobian), and their muscles carry their arms'
+  own inertia for that acceleration (M(q) qdd, through a muscle's activation lag,
+  ACTIVATION_S; not while they give way). Without it the arms' mass and the impedance
+  dragged the robot's hands at each start (the lean, the rise) exactly where the pull
+  advances psi (docs/design.md).
   The trunk is not dragged along but moves on its own: its flexion's set-point is the
   bend it takes to hold hands as high as they started plus the robot's CoM rise as the
   person saw it reaction_time_s ago, carried on at the rate seen (helper_body.bend_for):
   they straighten, leaning back, as the robot comes up. Feeling a pull beyond their
   intent's cap (YIELD_LATENCY_S ago) they give way, wholly from twice it: the set-point
   jumps to the posture and moves with it, and the trunk stops straightening. They let go (the
-  grip fades, never taken again) as the intent eases off, while the robot's CoM rises
-  through ease_com_rise_m as they saw it, or over ramp_s once the pull's time is over.
+  grip fades over ramp_s, never taken again) once the intent has eased off wholly (the
+  robot's CoM risen by ease_com_rise_m's upper end, as they saw it) or the pull's time
+  is over; a grip released while the intent still pulled dropped the robot's pull at once.
   The plant clamps each joint's sum to its strength.
   What failed, measured (docs/design.md): a set-point at the posture felt T ago carried
   on at the velocity felt (rang to 190 N in 1.3 s); a trunk following what moved it (a
   130 N m s/rad damper holding the rising robot down with 30 N); a trunk set by the
   hands' height seen, which it lifts itself (ran away to upright in 0.4 s); arms set to
-  where the robot's hands were seen (yanked at 70 N).
+  where the robot's hands were seen (yanked at 70 N); the arms' inertia carried for
+  their own hands' felt acceleration (a negative mass: fell at once); arms going with
+  the held hands with no regard to the trunk's motion (lifted the robot: 290-450 N
+  sole spikes).
 - Grips: the hands' spring-damper (helper_body.py), on the robot's hands and on the
   person's, what the robot's wrist sensors read.
 """
@@ -54,12 +66,18 @@ from drake_standup.world.helper_body import (
 )
 from drake_standup.world.human import PERCEPTION_PERIOD_S, HumanWrenchSource, applied_at
 
-# What the person perceives each update: the robot's CoM height and rate, and the larger
-# of the pulls they feel in their hands.
-_SEEN = 3
-# How soon they give way to a pull beyond what they mean: a long-latency stretch reflex's
-# latency (50-100 ms; a modelling choice). s.
+# What the person perceives each update: the robot's CoM height and rate, the larger of
+# the pulls they feel in their hands, and the velocities of the robot's hands they hold.
+_SEEN = 9
+# How late they feel what their hands hold (the pull, the held hands' motion): a
+# long-latency stretch reflex's latency (50-100 ms; a modelling choice). s.
 YIELD_LATENCY_S = 0.05
+# Muscles' activation time constant: a muscle's force follows its drive as a first-order
+# lag of 30-50 ms (activation 10-20 ms, deactivation 30-60 ms: Zajac 1989, Crit Rev
+# Biomed Eng 17:359); it low-passes the arms' inertia feed-forward. s.
+ACTIVATION_S = 0.04
+# The damping of the least-squares map from the grips' motion to the arms' joints. m^2.
+_ARMS_DAMPING = 1e-4
 
 
 class PersonController(LeafSystem):
@@ -84,6 +102,7 @@ class PersonController(LeafSystem):
         self._from_plant = np.array([in_plant.index(name) for name in names])
         self._to_actuators = np.array([names.index(name) for name in helper.person.joint_names])
         self._lumbar = names.index("lumbar_flexion")
+        self._arms = np.array([not name.startswith("lumbar") for name in names])
         self._bend0 = helper.q0["lumbar_flexion"]
         # The set-point's time constant and its step toward the posture per update.
         self._yield_s = YIELD_TIME_S[helper.config.tone]
@@ -108,6 +127,8 @@ class PersonController(LeafSystem):
         self._felt = self.DeclareVectorInputPort("grip_wrenches_W", 12)
         self._seen = self.DeclareDiscreteState(_SEEN * (self._slots + 1))
         self._command = self.DeclareDiscreteState(3 * n + 1)
+        self._inertia = self.DeclareDiscreteState(n)  # the arms' inertia torques, as activated
+        self._activate = min(1.0, PERCEPTION_PERIOD_S / ACTIVATION_S)
         self.DeclarePeriodicDiscreteUpdateEvent(PERCEPTION_PERIOD_S, 0.0, self._Update)
         self.DeclareInitializationDiscreteUpdateEvent(self._Start)
         ticket = {self.discrete_state_ticket(self._command)}
@@ -133,14 +154,27 @@ class PersonController(LeafSystem):
         return self._state.Eval(context)[self._n :][self._from_plant]
 
     def _look(self, context: Context) -> np.ndarray:
-        """(_SEEN,) [z, dz/dt, |f|]: the robot's CoM height and its rate, and the larger
-        grip force on their hands, now."""
+        """(_SEEN,) [z, dz/dt, |f|, v_l, v_r]: the robot's CoM height and its rate, the
+        larger grip force on their hands, and the velocities of the robot's hands they
+        hold (GRIPS' order, world), now."""
         plant, c, instances = self._plant, self._plant_context, [self._robot_instance]
         plant.SetPositionsAndVelocities(c, self._robot_instance, self._robot_state.Eval(context))
         z = plant.CalcCenterOfMassPositionInWorld(c, instances)[2]
         rate = plant.CalcCenterOfMassTranslationalVelocityInWorld(c, instances)[2]
         felt = self._felt.Eval(context).reshape(2, 6)[:, 3:]
-        return np.array([z, rate, np.linalg.norm(felt, axis=1).max()])
+        world = plant.world_frame()
+        held = [f.CalcSpatialVelocity(c, world, world).translational() for f in self._hands]
+        return np.concatenate([[z, rate, np.linalg.norm(felt, axis=1).max()], *held])
+
+    def _held_motion(self, seen: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(6,), (6,): the held hands' velocity and acceleration now as the person predicts
+        them from what they felt YIELD_LATENCY_S ago (carried on at the acceleration then)."""
+        samples = seen.reshape(-1, _SEEN)[:, 3:]
+        lag = self._yield_lag
+        if lag + 1 >= len(samples):  # too short a memory for a rate: no prediction
+            return samples[-1 - lag], np.zeros(6)
+        accel = (samples[-1 - lag] - samples[-2 - lag]) / PERCEPTION_PERIOD_S
+        return samples[-1 - lag] + lag * PERCEPTION_PERIOD_S * accel, accel
 
     def _Start(self, context: Context, discrete_state) -> None:
         q = self._posture(context)
@@ -150,7 +184,9 @@ class PersonController(LeafSystem):
         self._com_z0 = seen[0]
         discrete_state.set_value(self._seen, np.tile(seen, self._slots + 1))
         v_d = np.zeros(self._n)
-        discrete_state.set_value(self._command, self._command_from(context, q, q, v_d, 1.0))
+        discrete_state.set_value(
+            self._command, self._command_from(context, q, q, v_d, 1.0, np.zeros(self._n))
+        )
 
     def _Update(self, context: Context, discrete_state) -> None:
         q = self._posture(context)
@@ -165,6 +201,22 @@ class PersonController(LeafSystem):
         felt = seen[-_SEEN * (1 + self._yield_lag) + 2]
         give = min(1.0, max(0.0, felt / self._cap_N - 1.0)) if self._cap_N > 0 else 0.0
         q_d += (self._follow + give * (1.0 - self._follow)) * (q - q_d)
+        # Their arms move with the hands they hold, as far as they still hold them: the
+        # set-point at the held hands' predicted velocity, and their arms' own inertia
+        # carried (inverse dynamics of that motion, a feed-forward).
+        grip = command[-1]
+        velocity, accel = self._held_motion(seen)
+        model, c = self._model, self._context
+        model.SetPositions(c, q)
+        J = grips_jacobian(model, c)
+        trunk = ~self._arms  # the hands' motion their trunk already makes is not the arms'
+        velocity = velocity - J[:, trunk] @ self._rates(context)[trunk]
+        J = J[:, self._arms]
+        to_joints = np.linalg.solve(J.T @ J + _ARMS_DAMPING * np.eye(J.shape[1]), J.T)
+        dq, ddq = np.zeros(self._n), np.zeros(self._n)
+        dq[self._arms] = grip * (to_joints @ velocity)
+        ddq[self._arms] = (1.0 - give) * grip * (to_joints @ accel)
+        q_d += (1.0 - give) * PERCEPTION_PERIOD_S * dq
         # The CoM's rise they expect now: what they saw, carried on at its rate.
         rise = seen[0] + self._slots * PERCEPTION_PERIOD_S * seen[1] - self._com_z0
         height = self._height_m
@@ -173,23 +225,32 @@ class PersonController(LeafSystem):
         )
         q_d[self._lumbar] += (1.0 - give) * (planned - q_d[self._lumbar])
         # Their grip: held, let go of (never taken again) once the robot is up.
-        grip = command[-1]
-        if context.get_time() >= self._pull_end_s:
+        eased = seen[0] - self._com_z0 >= self._ease_m[1]  # the intent eased off wholly
+        if eased or context.get_time() >= self._pull_end_s:
             grip = max(0.0, grip - self._release_step)
-        low, high = self._ease_m
-        grip = min(grip, max(0.0, (high - rise) / (high - low)))
-        v_d = (1.0 - give) * (q - q_d) / self._yield_s + give * self._rates(context)
-        discrete_state.set_value(self._command, self._command_from(context, q, q_d, v_d, grip))
+        v_d = (1.0 - give) * ((q - q_d) / self._yield_s + dq) + give * self._rates(context)
+        inertia = discrete_state.get_mutable_value(self._inertia)
+        inertia += self._activate * (model.CalcMassMatrix(c) @ ddq - inertia)
+        discrete_state.set_value(
+            self._command, self._command_from(context, q, q_d, v_d, grip, inertia)
+        )
 
     def _command_from(
-        self, context: Context, q: np.ndarray, q_d: np.ndarray, v_d: np.ndarray, grip: float
+        self,
+        context: Context,
+        q: np.ndarray,
+        q_d: np.ndarray,
+        v_d: np.ndarray,
+        grip: float,
+        inertia: np.ndarray,
     ) -> np.ndarray:
         """[q_d, v_d, u_ff, grip]: in actuator order the set-point and its rate (model
-        order), and from the posture now (q) their weight and the intended pull (as far as
+        order), and from the posture now (q) their weight, their arms' inertia (the torques
+        that move them with the held hands, model order) and the intended pull (as far as
         they still hold the hands); their grip, 1 held, 0 let go."""
         model, c = self._model, self._context
         model.SetPositions(c, q)
-        u = -model.CalcGravityGeneralizedForces(c)
+        u = inertia - model.CalcGravityGeneralizedForces(c)
         f = self._intent.Eval(context).reshape(2, 6)[:, 3:]
         if np.any(f):
             u += grip * (grips_jacobian(model, c).T @ f.ravel())
