@@ -32,7 +32,7 @@
   where the robot's hands were seen (yanked at 70 N); the arms' inertia carried for
   their own hands' felt acceleration (a negative mass: fell at once); arms going with
   the held hands with no regard to the trunk's motion (lifted the robot: 290-450 N
-  sole spikes).
+  sole spikes in 3 of 8 people).
 - Grips: the hands' spring-damper (helper_body.py), on the robot's hands and on the
   person's, what the robot's wrist sensors read.
 """
@@ -208,10 +208,10 @@ class PersonController(LeafSystem):
         velocity, accel = self._held_motion(seen)
         model, c = self._model, self._context
         model.SetPositions(c, q)
-        J = grips_jacobian(model, c)
+        J_grips = grips_jacobian(model, c)
         trunk = ~self._arms  # the hands' motion their trunk already makes is not the arms'
-        velocity = velocity - J[:, trunk] @ self._rates(context)[trunk]
-        J = J[:, self._arms]
+        velocity = velocity - J_grips[:, trunk] @ self._rates(context)[trunk]
+        J = J_grips[:, self._arms]
         to_joints = np.linalg.solve(J.T @ J + _ARMS_DAMPING * np.eye(J.shape[1]), J.T)
         dq, ddq = np.zeros(self._n), np.zeros(self._n)
         dq[self._arms] = grip * (to_joints @ velocity)
@@ -232,7 +232,7 @@ class PersonController(LeafSystem):
         inertia = discrete_state.get_mutable_value(self._inertia)
         inertia += self._activate * (model.CalcMassMatrix(c) @ ddq - inertia)
         discrete_state.set_value(
-            self._command, self._command_from(context, q, q_d, v_d, grip, inertia)
+            self._command, self._command_from(context, q, q_d, v_d, grip, inertia, J_grips)
         )
 
     def _command_from(
@@ -243,17 +243,21 @@ class PersonController(LeafSystem):
         v_d: np.ndarray,
         grip: float,
         inertia: np.ndarray,
+        J_grips: np.ndarray | None = None,
     ) -> np.ndarray:
         """[q_d, v_d, u_ff, grip]: in actuator order the set-point and its rate (model
         order), and from the posture now (q) their weight, their arms' inertia (the torques
         that move them with the held hands, model order) and the intended pull (as far as
-        they still hold the hands); their grip, 1 held, 0 let go."""
+        they still hold the hands); their grip, 1 held, 0 let go. J_grips: the grips'
+        Jacobian at q, if the caller has it (_Update does)."""
         model, c = self._model, self._context
         model.SetPositions(c, q)
         u = inertia - model.CalcGravityGeneralizedForces(c)
         f = self._intent.Eval(context).reshape(2, 6)[:, 3:]
         if np.any(f):
-            u += grip * (grips_jacobian(model, c).T @ f.ravel())
+            if J_grips is None:
+                J_grips = grips_jacobian(model, c)
+            u += grip * (J_grips.T @ f.ravel())
         v_d = v_d.copy()
         v_d[self._lumbar] = 0.0  # the trunk's set-point is its own (not following q)
         order = self._to_actuators
