@@ -1,5 +1,5 @@
 """The run's figures: the paper's Fig. 3 (figure_advancement) and CoM tracking with the
-contact forces (figure_tracking), drawn from signals.npz's arrays."""
+contact forces and each limb's fastest joint (figure_tracking), from signals.npz."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from drake_standup.outputs.signals import group_normal_forces
+from drake_standup.robot.limbs import JOINT_GROUPS, joint_group
 
 STATE_COLORS = {2: "tab:orange", 3: "tab:green", 4: "tab:purple"}
 
@@ -88,11 +89,25 @@ def figure_advancement(
     plt.close(fig)
 
 
+def _plot_limb_speeds(ax, signals: dict[str, np.ndarray]) -> None:
+    """Each limb's fastest joint speed over time (a light limb above the trunk: a whip)."""
+    t = signals["time_s"]
+    limbs = np.array([joint_group(str(name)) for name in signals["joint_names"]])
+    speeds = np.abs(signals["joint_velocities_rad_per_s"])
+    for limb in JOINT_GROUPS:
+        if (limbs == limb).any():
+            ax.plot(t, speeds[:, limbs == limb].max(axis=1), label=limb, lw=1.0)
+    ax.set_ylabel("fastest joint [rad/s]")
+    ax.legend(fontsize=8, ncol=4)
+
+
 def figure_tracking(signals: dict[str, np.ndarray], entry_times_s, path: Path) -> None:
-    """CoM against its reference, and the contact normal forces, with the
-    state switches marked."""
+    """CoM against its reference, the contact normal forces and each limb's fastest
+    joint, with the state switches marked."""
     plt = _plt()
-    fig, (ax_x, ax_z, ax_f) = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+    fig, (ax_x, ax_z, ax_f, ax_v) = plt.subplots(
+        4, 1, figsize=(10, 10), sharex=True, gridspec_kw={"height_ratios": [1, 1, 1, 0.8]}
+    )
     t = signals["time_s"]
     for ax, axis in ((ax_x, 0), (ax_z, 2)):
         name = "xyz"[axis]
@@ -109,9 +124,10 @@ def figure_tracking(signals: dict[str, np.ndarray], entry_times_s, path: Path) -
     for group, fz in group_normal_forces(signals).items():
         ax_f.plot(t, fz, label=group)
     ax_f.set_ylabel("normal force [N]")
-    ax_f.set_xlabel("time [s]")
     ax_f.legend(fontsize=8)
-    for ax in (ax_x, ax_z, ax_f):
+    _plot_limb_speeds(ax_v, signals)
+    ax_v.set_xlabel("time [s]")
+    for ax in (ax_x, ax_z, ax_f, ax_v):
         _mark_states(ax, entry_times_s, label=ax is ax_x)
         ax.grid(alpha=0.3)
     ax_x.legend(fontsize=8)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from drake_standup.outputs.signals import group_normal_forces
+from drake_standup.robot.limbs import JOINT_GROUPS, joint_group, shoulder_tendon_margin_rad
 from drake_standup.world.human import HELPER_SPENT
 
 
@@ -278,6 +279,27 @@ def smoothness_metrics(
     return metrics
 
 
+def limb_metrics(signals: dict[str, np.ndarray]) -> dict:
+    """peak_joint_speed_<limb>_rad_per_s: the fastest |qdot| of any joint of each limb
+    (robot/limbs.py: JOINT_GROUPS) over the logged samples (a whip shows as a light limb
+    faster than the trunk that carries it); shoulder_tendon_margin_min_rad: the shoulders'
+    least distance to their tendon bound (negative: past it; None without shoulders)."""
+    names = [str(name) for name in signals["joint_names"]]
+    limbs = np.array([joint_group(name) for name in names])
+    speeds = np.abs(signals["joint_velocities_rad_per_s"])
+    metrics: dict = {}
+    for limb in JOINT_GROUPS:
+        columns = limbs == limb
+        peak = float(speeds[:, columns].max()) if columns.any() and len(speeds) else None
+        metrics[f"peak_joint_speed_{limb}_rad_per_s"] = peak
+    margin = signals.get("shoulder_tendon_margin_rad")
+    if margin is None:  # signals.npz before issue 46
+        margin = shoulder_tendon_margin_rad(signals["joint_positions_rad"], names)
+    finite = margin[np.isfinite(margin)] if len(margin) else margin
+    metrics["shoulder_tendon_margin_min_rad"] = float(finite.min()) if len(finite) else None
+    return metrics
+
+
 def sit_backs(state: np.ndarray) -> int:
     """How often the stand-up went back to state 1 once it had left it (a pull against
     it sat it back), from the state's samples."""
@@ -326,6 +348,8 @@ def run_metrics(
         metrics["joint_limit_slack_integral"] = float(np.sum(slack) * step) if step else 0.0
         # Ticks the QP was solved only with its contacts relaxed (control/qp.py).
         metrics["qp_relaxed_ticks"] = int(signals["qp_relaxed"][-1])
+        if "qp_fallback" in signals:  # ticks daqp failed and Clarabel solved (issue 46)
+            metrics["qp_fallback_ticks"] = int(signals["qp_fallback"][-1])
         # The robot's mass as the controller estimated it (weighing itself seated).
         metrics["model_mass_kg"] = float(signals["model_mass_scale"][-1] * mass_kg)
         # How long the stand-up waited for a pull against it to stop (state machine).
@@ -349,6 +373,7 @@ def run_metrics(
         metrics["path_deviation_max_m"] = path_deviation_max_m(
             signals["com_W"], signals["com_reference_W"]
         )
+    metrics.update(limb_metrics(signals))
     torques = signals["joint_torques_Nm"]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
     return metrics

@@ -16,6 +16,7 @@ from drake_standup.config import RESPONSES
 from drake_standup.control.contacts import CONTACTS
 from drake_standup.control.controller import DIAGNOSTICS
 from drake_standup.ports.payloads import COM_REFERENCE, SEGMENT
+from drake_standup.robot.limbs import joint_group, shoulder_tendon_margin_rad
 from drake_standup.world.helper_body import state_order
 from drake_standup.world.human import HELPER_SPENT
 
@@ -101,7 +102,11 @@ def _station_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarr
         "joint_positions_rad": state[:, joints.q_index],
         "joint_velocities_rad_per_s": state[:, nq + joints.v_index],
         "joint_torques_Nm": logs["net_actuation"],
+        "joint_groups": np.array([joint_group(name) for name in joints.names], dtype=str),
     }
+    signals["shoulder_tendon_margin_rad"] = shoulder_tendon_margin_rad(
+        signals["joint_positions_rad"], joints.names
+    )
     if "push_force_W" in logs:
         signals["push_force_W"] = logs["push_force_W"]
     if "standing_pull_usage" in logs:  # sensing.standing_pull_usage of the measured pull
@@ -165,6 +170,7 @@ def _controller_signals(logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         "qp_failures": diagnostics["qp_failures"][:, 0].astype(np.int64),
         "joint_limit_slack": diagnostics["joint_limit_slack"][:, 0],
         "qp_relaxed": diagnostics["qp_relaxed"][:, 0].astype(np.int64),
+        "qp_fallback": diagnostics["qp_fallback"][:, 0].astype(np.int64),
         "com_lean_W": logs["lean_W"],
         # The controller's model mass over the nominal, as it weighed the robot seated.
         "model_mass_scale": logs["mass_estimate"][:, 0],
