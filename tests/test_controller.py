@@ -22,11 +22,16 @@ from pydrake.systems.framework import DiagramBuilder
 from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
 from drake_standup.config.phases import PhaseTable
 from drake_standup.control.contacts import CONTACTS, rectangle_yaw_rows
-from drake_standup.control.controller import DIAGNOSTICS, WholeBodyController
+from drake_standup.control.controller import DIAGNOSTICS, WholeBodyController, next_diagnostics
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
 from drake_standup.control.tasks import helpful_force
+from drake_standup.control.tasks.joint_limits import (
+    braking_bounds,
+    joint_limit_acceleration_bounds,
+)
 from drake_standup.control.terms import RobotKinematics
+from drake_standup.robot.limbs import SHOULDER_JOINTS, shoulder_tendon_rows
 from drake_standup.standup.contact_schedule import contact_commands, phase_seat_hold
 from drake_standup.standup.task_references import PhaseReferences, ReferenceGenerator
 from drake_standup.standup.transitions import initial_mode
@@ -725,3 +730,124 @@ def test_screened_soft_rows_give_the_full_programs_solution(scene, seed, standup
         np.testing.assert_allclose(screened.vdot, full.vdot, atol=1e-6)
         np.testing.assert_allclose(screened.F_C, full.F_C, atol=1e-6)
         np.testing.assert_allclose(screened.slack, full.slack, atol=1e-7)
+
+
+def test_daqps_infeasible_verdicts_checked_against_clarabel(scene):
+    """On 200 random states with a binding 20 N m torque limit, every program Clarabel
+    solves is solved unrelaxed by the controller's daqp (itself, or through its Clarabel
+    fallback where daqp calls it infeasible) within the limit; none is relaxed that
+    Clarabel solves. (Near the limit the optimum is flat in some torques: daqp, Clarabel
+    and OSQP agree on the cost but part by up to 3 N m on seed 6, so the torques are not
+    compared. daqp 0.11 with numpy 2.4 here calls about one in three of these programs
+    infeasible; which ones moves with the machine's numerics.)"""
+    scene_, x0 = scene
+    plant, instance = scene_.plant, scene_.robot.model_instance
+    rigs = {
+        name: _Rig(scene_, qp_solver=name, torque_limit_Nm=20.0) for name in ("daqp", "clarabel")
+    }
+    solvable = fallbacks = 0
+    for seed in range(200):
+        x = _random_state(plant, instance, x0, np.random.default_rng(seed))
+        reference = np.concatenate([_com(plant, instance, x), np.zeros(6)])
+        solutions = {}
+        for name, rig in rigs.items():
+            rig.fix(x, reference, 2)
+            solutions[name] = rig.tick()
+        clarabel, daqp_ = solutions["clarabel"], solutions["daqp"]
+        if not (clarabel.ok and not clarabel.relaxed):
+            continue
+        solvable += 1
+        fallbacks += daqp_.fallback
+        assert daqp_.ok and not daqp_.relaxed, f"seed {seed}: Clarabel solves it, daqp relaxed it"
+        assert np.abs(daqp_.tau).max() <= 20.0 + 1e-5
+    assert solvable >= 100  # the check compared most states
+    controller = rigs["daqp"].controller
+    assert fallbacks == controller.program(controller._last[0].active).qp.fallback_solves
+    print(f"{solvable} of 200 solvable, {fallbacks} of them through the fallback")
+
+
+def test_a_failed_daqp_solve_is_solved_by_the_fallback_and_counted(scene, monkeypatch):
+    """daqp made to fail every program: the tick is Clarabel's (the same torques as a
+    Clarabel controller's), QpSolution.fallback is set and the controller counts it."""
+    from drake_standup.control import backends
+
+    scene_, x0 = scene
+    plant, instance = scene_.plant, scene_.robot.model_instance
+    x = _random_state(plant, instance, x0, np.random.default_rng(8))
+    reference = np.concatenate([_com(plant, instance, x), np.zeros(6)])
+    clarabel = _Rig(scene_, qp_solver="clarabel")
+    clarabel.fix(x, reference, 2)
+    expected = clarabel.tick()
+    # daqp's own answer on every program: infeasible (exit flag -1).
+    monkeypatch.setattr(backends.daqp, "solve", lambda H, g, *rest: (np.zeros(len(g)), 0, -1, {}))
+    rig = _Rig(scene_)
+    rig.fix(x, reference, 2)
+    solution = rig.tick()
+    assert solution.ok and solution.fallback and not solution.relaxed
+    np.testing.assert_allclose(solution.tau, expected.tau, atol=1e-4)
+    before = np.zeros(DIAGNOSTICS.size)
+    tick = rig.system.calc_tick(rig.context)[0]
+    after = next_diagnostics(before, tick, 0.0)
+    assert after[DIAGNOSTICS.index("qp_fallback")] == 1.0
+    assert after[DIAGNOSTICS.index("qp_relaxed")] == 0.0
+
+
+def _pressed_into_a_tendon(scene, seed):
+    """A random seated state with the left shoulder 1 mrad inside its tendon bound of
+    row 1 (p - r < 54.3 deg: pitch up, roll down) and moving into it at 2 rad/s."""
+    scene_, x0 = scene
+    plant, instance = scene_.plant, scene_.robot.model_instance
+    x = _random_state(plant, instance, x0, np.random.default_rng(seed)).copy()
+    context = plant.CreateDefaultContext()
+    plant.SetPositionsAndVelocities(context, instance, x)
+    a, b = shoulder_tendon_rows()
+    joints = [plant.GetJointByName(f"l_{name}", instance) for name in SHOULDER_JOINTS]
+    q = np.array([j.get_angle(context) for j in joints])
+    row = 1
+    q = q - (a[row] @ q + b[row] - 1e-3) * a[row]  # onto the row's plane, 1 mrad inside
+    for joint, angle, rate in zip(joints, q, -2.0 * a[row], strict=True):
+        joint.set_angle(context, float(angle))
+        joint.set_angular_rate(context, float(rate))
+    return plant.GetPositionsAndVelocities(context, instance), a[row], joints
+
+
+def test_the_shoulder_tendon_rows_brake_a_shoulder_moving_into_its_bound(scene):
+    """A shoulder 1 mrad inside its tendon bound and closing on it at 2 rad/s: the QP's
+    tendon row asks a^T qddot for at least the joint-limit bounds of that distance and
+    rate (control/tasks/joint_limits.py's two, computed here), its slack is exactly the
+    shortfall, and it brakes the shoulder harder than the same program without the rows.
+    Screened and full programs agree with the row in play."""
+    x, a_row, joints = _pressed_into_a_tendon(scene, 1)
+    plant, instance = scene[0].plant, scene[0].robot.model_instance
+    reference = np.concatenate([_com(plant, instance, x), np.zeros(6)])
+    columns = np.array([j.velocity_start() for j in joints])  # the robot's v is the plant's
+    config = ControllerConfig()
+    # The distance to the bound (rad) and its rate; the row's lower bound on a^T qddot,
+    # the tighter of the horizon's and the braking reserve's.
+    distance, rate, no_bound = np.array([1e-3]), np.array([-2.0]), np.full(1, np.inf)
+    horizon_s = config.joint_limit_horizon_s
+    low = max(
+        joint_limit_acceleration_bounds(distance, rate, np.zeros(1), no_bound, horizon_s)[0][0],
+        braking_bounds(
+            distance, rate, np.zeros(1), no_bound, config.joint_braking_rad_per_s2, horizon_s
+        )[0][0],
+    )
+    values, slacks = {}, {}
+    for tendons, screen in ((True, True), (True, False), (False, True)):
+        rig = _Rig(scene[0], shoulder_tendons=tendons)
+        rig.fix(x, reference, 2)
+        rig.tick()
+        qp = rig.controller.program(rig.controller._last[0].active).qp
+        qp._screen = screen
+        solution = rig.tick()
+        assert solution.ok
+        values[tendons, screen] = a_row @ solution.vdot[columns]
+        slacks[tendons, screen] = solution.slack
+    nu = plant.num_actuators()
+    row = nu + 1  # the left shoulder's row 1, after one row per joint
+    held = values[True, True]
+    assert held < low  # the pull past it is strong: the row is in play, with its slack
+    np.testing.assert_allclose(-slacks[True, True][row], low - held, atol=1e-6)
+    np.testing.assert_allclose(values[True, False], held, atol=1e-6)
+    np.testing.assert_allclose(slacks[True, False], slacks[True, True], atol=1e-7)
+    assert values[False, True] < held - 10.0  # without the rows it runs on into the bound

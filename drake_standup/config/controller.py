@@ -43,6 +43,10 @@ class ControllerConfig:
     # ... softly: a slack s per joint at the cost w s^2 (rad/s^2); hard bounds made the
     # QP infeasible where the soles pin the legs or the pull holds the shoulders.
     joint_limit_weight: float = 1.0e3
+    # The shoulders' tendon-bound range, A q + b > 0 over pitch, roll and yaw (iCub 2.x:
+    # icub-tech, "Range of Motion of the iCub Shoulders"; robot/limbs.py), held as the joint
+    # limits are: soft rows with the same horizon, braking and weight.
+    shoulder_tendons: bool = True
     # Base (root_link) orientation: upright at the yaw of the first tick, pitched forward
     # by the phase's base_pitch_rad. The probe ended stooped 25 deg (SPEC 7). 1/s^2.
     base_orientation_kp_per_s2: float = 30.0

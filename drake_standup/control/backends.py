@@ -31,6 +31,11 @@ class DaqpBackend:
 
     def __init__(self, size: int):
         self._sense = np.zeros(size, dtype=np.int32)
+        # daqp's infeasible verdict is wrong on some programs that have a solution
+        # (tests/test_controller.py counts them on random states): Clarabel tries each
+        # program daqp fails, and only a solution meeting its rows is taken.
+        self._fallback: dict[tuple[int, int], DrakeBackend] = {}
+        self.fallbacks = 0  # programs daqp failed that Clarabel solved
 
     def solve(self, H, g, A, lo, hi, equality) -> tuple[np.ndarray, bool]:
         """Any size of program (the QP leaves rows out: control/qp.py)."""
@@ -40,7 +45,24 @@ class DaqpBackend:
         else:
             sense = (equality * self.EQUALITY).astype(np.int32)
         z, _, exitflag, _ = daqp.solve(H, g, A, hi, lo, sense)
-        return np.asarray(z), exitflag >= 1
+        if exitflag >= 1:
+            return np.asarray(z), True
+        n, m = len(g), len(A)
+        fallback = self._fallback.get((n, m))
+        if fallback is None:
+            fallback = self._fallback[n, m] = DrakeBackend("clarabel", n, m)
+        z, ok = fallback.solve(H, g, A, lo, hi, equality)
+        ok = ok and bool(np.isfinite(z).all()) and _meets(z, A, lo, hi)
+        self.fallbacks += int(ok)
+        return z, ok
+
+
+def _meets(z, A, lo, hi, tolerance: float = 1e-6) -> bool:
+    """Whether z meets the simple bounds and rows within tolerance, relative (an
+    interior-point solver's equalities hold to ~1e-8)."""
+    values = np.concatenate((z, A @ z))
+    slack = tolerance * (1.0 + np.abs(values))
+    return bool(np.all(values >= lo - slack) and np.all(values <= hi + slack))
 
 
 class DrakeBackend:

@@ -43,6 +43,7 @@ from drake_standup.control.tasks import (
 )
 from drake_standup.control.terms import RobotTerms
 from drake_standup.ports.payloads import VectorLayout
+from drake_standup.robot.limbs import shoulder_tendon_limits
 
 DIAGNOSTICS = VectorLayout(
     ("qp_ok", 1),  # 1 if this tick's QP succeeded, else 0 (torques held)
@@ -52,11 +53,13 @@ DIAGNOSTICS = VectorLayout(
     ("commanded_normal_force_N", len(CONTACTS)),  # f_z asked of CONTACTS (NaN: failed)
     ("joint_limit_slack", 1),  # largest slack of the soft joint-limit bounds, rad/s^2
     ("qp_relaxed", 1),  # ticks solved only with the contacts relaxed, since the start
+    ("qp_fallback", 1),  # ticks daqp failed and the fallback solver solved, since the start
 )
 # Columns of WholeBodyController.timing_s().
 TIMING = ("inputs_s", "kinematics_s", "assembly_s", "solve_s", "total_s")
 _COMMANDED = DIAGNOSTICS["commanded_normal_force_N"]
 _FAILURES, _RELAXED = DIAGNOSTICS.index("qp_failures"), DIAGNOSTICS.index("qp_relaxed")
+_FALLBACK = DIAGNOSTICS.index("qp_fallback")
 
 
 @dataclass(frozen=True)
@@ -100,6 +103,8 @@ def make_program(
             joints.q_max,
             config.joint_limit_horizon_s,
             config.joint_braking_rad_per_s2,
+            shoulder_tendon_limits(joints.names) if config.shoulder_tendons else None,
+            plant.num_velocities(),
         ),
         soft_bound_weight=config.joint_limit_weight,
         solver=config.qp_solver,
@@ -304,4 +309,5 @@ def next_diagnostics(before: np.ndarray, tick: ControllerTick, total_s: float) -
         commanded_normal_force_N=tick.normal_forces_N if solution.ok else np.nan,
         joint_limit_slack=float(np.abs(solution.slack).max()) if solution.slack.size else 0.0,
         qp_relaxed=before[_RELAXED] + float(solution.relaxed),
+        qp_fallback=before[_FALLBACK] + float(solution.fallback),
     )

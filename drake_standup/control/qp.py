@@ -18,7 +18,8 @@ The program, built once and refilled every tick:
                                                       k: a slip braked back to rest)
            K_c F_c <= 0,  f_z,c in [lo_c, hi_c]       each contact
            -tau_max <= T z + t0 <= tau_max            torque limits
-           vdot_min <= vdot <= vdot_max               joint limits (control/tasks/)
+           vdot_min <= vdot <= vdot_max               joint limits, and the shoulders'
+                                                      tendon rows (control/tasks/)
 
 The program holds only the contacts that are active: the controller keeps one per set
 of active contacts (its size, and so its solve time, shrinks once the seat is released).
@@ -38,6 +39,10 @@ slack is a relaxation of the full one (a constraint and a non-negative cost term
 so its optimum is the full program's whenever it keeps that joint's vdot within its bounds
 with no slack: every tick checks that, and solves again with the joints that break it.
 The joints kept are those whose row was in play at the last tick (at a bound or slack).
+
+daqp's infeasible verdict is wrong on some programs that have a solution (random states
+near a torque limit): where it fails a program, Clarabel solves it before the relaxed
+fallback is tried (counted: QpSolution.fallback, metrics' qp_fallback_ticks).
 """
 
 import time
@@ -58,6 +63,7 @@ from drake_standup.control.qp_types import (
     as_slice,
 )
 from drake_standup.control.qp_types import QpLayout as QpLayout
+from drake_standup.control.soft_rows import SoftRows
 from drake_standup.control.targets import TaskReferences
 from drake_standup.control.terms import RobotTerms
 
@@ -94,10 +100,10 @@ class WholeBodyQp:
         tasks: the cost's tasks. modes: the values references.standup_state takes
         (each task is active in its active_states of them). acceleration_bounds: bounds on
         entries of vdot, computed each tick (None: none). soft_bounds: bounds that a slack
-        s per entry may move, vdot_min <= vdot - s <= vdot_max, at the cost
-        soft_bound_weight s^2 (at the optimum |s| is the violation; one two-sided row per
-        entry, the slacks last in z, after the layout's unknowns): the program stays
-        feasible whatever the state."""
+        s per row may move, vdot_min <= vdot - s <= vdot_max (and c^T vdot - s for each of
+        its combined_rows c, where it has them), at the cost soft_bound_weight s^2 (at the
+        optimum |s| is the violation; one two-sided row each, the slacks last in z, after
+        the layout's unknowns): the program stays feasible whatever the state."""
         nv, nu = B.shape
         if not (np.all((B == 0) | (B == 1)) and np.all(B.sum(axis=0) == 1)):
             raise ValueError("the actuation matrix B must select one velocity per actuator")
@@ -111,7 +117,11 @@ class WholeBodyQp:
         self._torque_weight = torque_weight
         nw = layout.n_wrench
         self._soft_bounds = soft_bounds
-        n_soft = 0 if soft_bounds is None else len(soft_bounds.v_indices)
+        # Soft rows: one per entry of v_indices (vdot_i), then one per combined row (c^T vdot).
+        self._combined = np.zeros((0, B.shape[0]))
+        if soft_bounds is not None and getattr(soft_bounds, "combined_rows", None) is not None:
+            self._combined = np.asarray(soft_bounds.combined_rows, dtype=float)
+        n_soft = 0 if soft_bounds is None else len(soft_bounds.v_indices) + len(self._combined)
         self.n = n = layout.n + n_soft  # unknowns: the layout's, then the slacks
         self._slack = slice(layout.n, n)
 
@@ -144,6 +154,7 @@ class WholeBodyQp:
             (A[:rows], lo[: n + rows], hi[: n + rows], self._equality[: n + rows], None)
             for rows in (self._rows_tau.start, m)
         ]
+        self.fallback_solves = 0  # ticks solved by daqp's fallback
 
     def _lay_out_rows(self, nu: int, n_soft: int) -> tuple[slice, slice]:
         """Allocates A, lo, hi, equality with the constant rows; returns the held and (1) rows."""
@@ -175,8 +186,10 @@ class WholeBodyQp:
         self._equality[self._bounds(slice(rows_dynamics.start, self._rows_tau.start))] = 1
         if n_soft:
             entries = np.arange(n_soft)
+            n_single = len(soft_bounds.v_indices)
             columns = layout.vdot.start + np.asarray(soft_bounds.v_indices, dtype=int)
-            A[rows_soft.start + entries, columns] = 1.0
+            A[rows_soft.start + entries[:n_single], columns] = 1.0
+            A[rows_soft.start + n_single : rows_soft.stop, layout.vdot] = self._combined
             A[rows_soft.start + entries, self._slack.start + entries] = -1.0
             self._soft_lo = lo[self._bounds(rows_soft)]
             self._soft_hi = hi[self._bounds(rows_soft)]
@@ -184,16 +197,19 @@ class WholeBodyQp:
         return rows_acc, rows_dynamics
 
     def _set_up_screening(self, n_soft: int) -> None:
-        """Screening the soft rows (module docstring): their vdot columns, the joints kept."""
-        # Their vdot columns, their rows of A, their slacks' entries of z; which joints the
-        # next tick keeps. daqp only: the Drake backends hold programs of one size.
+        """Screening the soft rows (module docstring; soft_rows.py), and which rows the
+        next tick keeps. daqp only: the Drake backends hold programs of one size."""
         soft_bounds = self._soft_bounds
-        self._soft_vdot = self.layout.vdot.start + (
-            np.zeros(0, dtype=int) if soft_bounds is None else np.asarray(soft_bounds.v_indices)
+        self._soft_rows = SoftRows(
+            self.n,
+            self.layout.vdot,
+            np.zeros(0, dtype=int) if soft_bounds is None else soft_bounds.v_indices,
+            self._combined,
+            self._slack.start,
+            self._rows_soft.start,
         )
         self._screen = bool(n_soft) and self._solver == "daqp"
         self._soft_kept = np.zeros(n_soft, dtype=bool)
-        self._screen_cache: dict[tuple[bytes, int], tuple[np.ndarray, ...]] = {}
         self.screening_resolves = 0  # ticks that had to solve again (a joint broke in)
 
     def _make_views(self, B: np.ndarray, rows_acc: slice, rows_dynamics: slice) -> None:
@@ -247,7 +263,7 @@ class WholeBodyQp:
             if kept.all():
                 z, ok = backend.solve(H, g, A, lo, hi, equality)
                 break
-            dropped, columns, rows, entries = self._screened_indices(kept, m)
+            dropped, columns, rows, entries = self._soft_rows.screened_indices(kept, m)
             z_kept, ok = backend.solve(
                 H.take(columns, 0).take(columns, 1),
                 g.take(columns),
@@ -260,7 +276,7 @@ class WholeBodyQp:
             z[columns] = z_kept
             if not ok:
                 break  # a relaxation infeasible: so is the full program
-            vdot = z[self._soft_vdot[dropped]]
+            vdot = self._soft_rows.values(z, dropped)
             tolerance = 1e-9 * (1.0 + np.abs(vdot))
             broken = (vdot < soft_lo[dropped] - tolerance) | (vdot > soft_hi[dropped] + tolerance)
             if not broken.any():
@@ -271,26 +287,11 @@ class WholeBodyQp:
         if ok:
             # In play: at a bound (within 1e-6 of its width) or moved by its slack.
             s = z[self._slack]
-            v = z[self._soft_vdot] - s
-            width = 1e-6 * (1.0 + soft_hi - soft_lo)
+            v = self._soft_rows.values(z) - s
+            span = soft_hi - soft_lo  # a one-sided row's (a tendon's) is infinite
+            width = 1e-6 * (1.0 + np.where(np.isfinite(span), span, 0.0))
             self._soft_kept = (np.abs(s) > 1e-9) | (v <= soft_lo + width) | (v >= soft_hi - width)
         return z, ok
-
-    def _screened_indices(self, kept: np.ndarray, m: int) -> tuple[np.ndarray, ...]:
-        """For the soft rows kept (bool, per joint) of a program of m rows: the joints
-        left out, and the kept entries of z, rows of A and entries of lo, hi (integer
-        arrays: take() copies them several times faster than a boolean mask)."""
-        key = (kept.tobytes(), m)
-        indices = self._screen_cache.get(key)
-        if indices is None:
-            dropped = np.flatnonzero(~kept)
-            columns = np.setdiff1d(np.arange(self.n), self._slack.start + dropped)
-            rows = np.setdiff1d(np.arange(m), self._rows_soft.start + dropped)
-            entries = np.concatenate((columns, self.n + rows))
-            if len(self._screen_cache) > 256:  # joints in play come and go
-                self._screen_cache.clear()
-            indices = self._screen_cache[key] = (dropped, columns, rows, entries)
-        return indices
 
     def _solve_relaxed(self, H: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, bool]:
         """The fallback when the program is infeasible (or the solver fails): the same
@@ -337,7 +338,8 @@ class WholeBodyQp:
         r_actuated = r[self._actuated]
         H, g = self._cost(active, r_actuated)
         t_assembled = time.perf_counter()
-        z, ok, tau, relaxed = self._solve_within_limits(H, g, r_actuated)
+        z, ok, tau, relaxed, fallback = self._solve_within_limits(H, g, r_actuated)
+        self.fallback_solves += int(fallback)
         t_solved = time.perf_counter()
         nc, nw = len(self.contacts), self.layout.n_wrench
         F_C = np.zeros((nc, WRENCH_SIZE))
@@ -348,6 +350,7 @@ class WholeBodyQp:
             vdot=z[self.layout.vdot],
             slack=z[self._slack],
             relaxed=relaxed,
+            fallback=fallback,
             F_C=F_C,
             tau=tau,
             assembly_s=t_assembled - t_start,
@@ -419,9 +422,11 @@ class WholeBodyQp:
 
     def _solve_within_limits(
         self, H: np.ndarray, g: np.ndarray, r_actuated: np.ndarray
-    ) -> tuple[np.ndarray, bool, np.ndarray, bool]:
-        """z, ok, tau, relaxed: without the torque rows, then with them, then relaxed if need be."""
+    ) -> tuple[np.ndarray, bool, np.ndarray, bool, bool]:
+        """z, ok, tau, relaxed, fallback: without the torque rows, then with them, then
+        relaxed if need be; fallback: the solution is the fallback solver's (backends.py)."""
         T = self._T
+        fallbacks = self._fallbacks()
         for k, (A, lo_k, hi_k, equality, backend) in enumerate(self._programs):
             if backend is None:
                 backend = make_backend(self._solver, *A.shape[::-1])
@@ -438,4 +443,8 @@ class WholeBodyQp:
             tau = T @ z
             tau -= r_actuated
             relaxed = ok
-        return z, ok, tau, relaxed
+        return z, ok, tau, relaxed, ok and not relaxed and self._fallbacks() > fallbacks
+
+    def _fallbacks(self) -> int:
+        """Programs daqp failed that its fallback solved, so far (backends.py)."""
+        return sum(getattr(program[-1], "fallbacks", 0) for program in self._programs)

@@ -63,9 +63,11 @@ class Task:
 
 class AccelerationBounds(Protocol):
     """Bounds vdot_min <= vdot[v_indices] <= vdot_max that change with the state
-    (control/tasks/: JointLimitBounds)."""
+    (control/tasks/: JointLimitBounds); a soft bound may add combined rows (k x nv), each
+    bounding c^T vdot, after those of v_indices in calc()'s arrays."""
 
     v_indices: np.ndarray
+    combined_rows: np.ndarray | None
 
     def calc(self, terms: RobotTerms) -> tuple[np.ndarray, np.ndarray]:
         """(vdot_min, vdot_max) at terms' state."""
@@ -98,6 +100,8 @@ class QpSolution:
     # Solved only with the contacts relaxed (WholeBodyQp._solve_relaxed): the torques are
     # the best the program could do, not a command that keeps the contacts.
     relaxed: bool = False
+    # Solved by the fallback solver where daqp called the program infeasible (qp.py).
+    fallback: bool = False
 
     @cached_property
     def F_W(self) -> np.ndarray:

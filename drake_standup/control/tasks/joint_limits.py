@@ -1,4 +1,6 @@
-"""The joint limits as soft acceleration bounds (the QP's slack keeps it feasible)."""
+"""The joint limits as soft acceleration bounds (the QP's slack keeps it feasible): each
+joint's box [q_min, q_max], and linear limits a^T q + b >= 0 over several joints (the
+iCub's shoulder tendons: robot/limbs.py), each a row of the QP on a^T qddot."""
 
 import numpy as np
 
@@ -9,7 +11,10 @@ from drake_standup.control.terms import RobotTerms
 class JointLimitBounds:
     """vdot_min <= vdot[v_indices] <= vdot_max for the given joints, from their limits
     q_min, q_max and the horizon T (horizon_s): joint_limit_acceleration_bounds, tightened
-    by braking_bounds where braking_rad_per_s2 is given."""
+    by braking_bounds where braking_rad_per_s2 is given. With linear_limits (a, b): rows
+    a q_joints + b >= 0 (a: k x joints, unit-norm rows, so that a braking rate in rad/s^2
+    reads the same as a joint's), bounded alike from below on a qddot, as combined_rows
+    (k x num_velocities) after the joints' rows."""
 
     def __init__(
         self,
@@ -19,23 +24,37 @@ class JointLimitBounds:
         q_max: np.ndarray,
         horizon_s: float,
         braking_rad_per_s2: float | None = None,
+        linear_limits: tuple[np.ndarray, np.ndarray] | None = None,
+        num_velocities: int | None = None,
     ):
         self.v_indices = v_indices
         self._q, self._v = as_slice(q_indices), as_slice(v_indices)
         self._q_min, self._q_max = q_min, q_max
         self._horizon_s = horizon_s
         self._braking = braking_rad_per_s2
+        self.combined_rows = None
+        if linear_limits is not None and len(linear_limits[0]):
+            a, b = linear_limits
+            self._a, self._minus_b = np.asarray(a, dtype=float), -np.asarray(b, dtype=float)
+            self.combined_rows = np.zeros((len(a), num_velocities))
+            self.combined_rows[:, v_indices] = self._a
 
     def calc(self, terms: RobotTerms) -> tuple[np.ndarray, np.ndarray]:
         """(vdot_min, vdot_max) at terms' state."""
         q, qdot = terms.q[self._q], terms.v[self._v]
-        low, high = joint_limit_acceleration_bounds(
-            q, qdot, self._q_min, self._q_max, self._horizon_s
-        )
+        low, high = self._bounds(q, qdot, self._q_min, self._q_max)
+        if self.combined_rows is None:
+            return low, high
+        s, sdot = self._a @ q, self._a @ qdot
+        s_low, s_high = self._bounds(s, sdot, self._minus_b, np.full(len(s), np.inf))
+        return np.concatenate((low, s_low)), np.concatenate((high, s_high))
+
+    def _bounds(self, q, qdot, q_min, q_max) -> tuple[np.ndarray, np.ndarray]:
+        low, high = joint_limit_acceleration_bounds(q, qdot, q_min, q_max, self._horizon_s)
         if self._braking is None:
             return low, high
         brake_low, brake_high = braking_bounds(
-            q, qdot, self._q_min, self._q_max, self._braking, self._horizon_s
+            q, qdot, q_min, q_max, self._braking, self._horizon_s
         )
         return np.maximum(low, brake_low), np.minimum(high, brake_high)
 
