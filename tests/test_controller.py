@@ -22,7 +22,12 @@ from pydrake.systems.framework import DiagramBuilder
 from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
 from drake_standup.config.phases import PhaseTable
 from drake_standup.control.contacts import CONTACTS, rectangle_yaw_rows
-from drake_standup.control.controller import DIAGNOSTICS, WholeBodyController, next_diagnostics
+from drake_standup.control.controller import (
+    DIAGNOSTICS,
+    WholeBodyController,
+    next_diagnostics,
+    posture_weights,
+)
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
 from drake_standup.control.tasks import helpful_force
@@ -851,3 +856,41 @@ def test_the_shoulder_tendon_rows_brake_a_shoulder_moving_into_its_bound(scene):
     np.testing.assert_allclose(values[True, False], held, atol=1e-6)
     np.testing.assert_allclose(slacks[True, False], slacks[True, True], atol=1e-7)
     assert values[False, True] < held - 10.0  # without the rows it runs on into the bound
+
+
+def _outboard_mass_kg(plant, instance, joint_name):
+    """The mass of the bodies outboard of a joint, walking the tree from its child body."""
+    joint = plant.GetJointByName(joint_name, instance)
+    bodies, grew = {joint.child_body().index()}, True
+    while grew:
+        grew = False
+        for index in plant.GetJointIndices(instance):
+            other = plant.get_joint(index)
+            if other.parent_body().index() in bodies and other.child_body().index() not in bodies:
+                bodies.add(other.child_body().index())
+                grew = True
+    return sum(plant.get_body(body).default_mass() for body in bodies)
+
+
+def test_carried_limbs_weigh_by_the_mass_they_carry(scene):
+    """Each arm and neck joint's posture weight is the torso pitch's times the mass the
+    torso carries over the mass the joint carries (each walked out of the tree here); a
+    joint the table names keeps its value; the legs keep posture_weight; off, all flat."""
+    scene_, _ = scene
+    plant, robot = scene_.plant, scene_.robot
+    joints = ControllerJoints.of(plant, robot)
+    config = ControllerConfig(
+        posture_weight_by_joint={"torso_pitch": 2.0, "l_elbow": 0.5},
+        carried_limb_weight_by_mass=True,
+    )
+    w = dict(zip(joints.names, posture_weights(plant, joints, config), strict=True))
+    torso = _outboard_mass_kg(plant, robot.model_instance, "torso_pitch")
+    for name in ("r_shoulder_pitch", "r_elbow", "l_wrist_yaw", "neck_pitch"):
+        expected = 2.0 * torso / _outboard_mass_kg(plant, robot.model_instance, name)
+        np.testing.assert_allclose(w[name], expected, rtol=1e-12)
+    assert w["r_wrist_yaw"] > w["r_elbow"] > w["r_shoulder_pitch"] > 2.0  # lighter, dearer
+    assert w["l_elbow"] == 0.5 and w["torso_pitch"] == 2.0
+    assert w["l_knee"] == config.posture_weight
+    flat = dataclasses.replace(config, carried_limb_weight_by_mass=False)
+    w_flat = dict(zip(joints.names, posture_weights(plant, joints, flat), strict=True))
+    assert w_flat["r_elbow"] == config.posture_weight and w_flat["l_elbow"] == 0.5

@@ -64,6 +64,13 @@ class ControllerConfig:
     posture_weight_by_joint: dict[str, float] = field(
         default_factory=lambda: {"torso_pitch": 1.0, "torso_roll": 1.0, "torso_yaw": 1.0}
     )
+    # True: the joints of the limbs the trunk carries (arms, neck) not named there weigh
+    # the torso pitch's weight times the mass the torso carries over the mass the joint
+    # carries (6 at a shoulder, 13 at an elbow, 17-64 at a wrist, 9-10 at the neck on
+    # iCubGazeboV2_5). It takes the whip out of the lean (arms 5.3 -> 3.75 rad/s) and keeps
+    # a 30 N pull from toppling the robot, but costs the default run 0.05 s and the
+    # hips' plan fidelity: off until that is mended (docs/design.md, issue 46).
+    carried_limb_weight_by_mass: bool = False
     # Base orientation weight: the pelvis ends upright to 0.3 deg (1.4 deg at 1).
     base_orientation_weight: float = 10.0
     # Each 6-D contact's CoP to the centre of its box (N m): it shares the load, which the

@@ -43,7 +43,10 @@ from drake_standup.control.tasks import (
 )
 from drake_standup.control.terms import RobotTerms
 from drake_standup.ports.payloads import VectorLayout
-from drake_standup.robot.limbs import shoulder_tendon_limits
+from drake_standup.robot.limbs import joint_group, shoulder_tendon_limits
+
+# Limbs the trunk carries, whose posture weight follows their mass (posture_weights).
+CARRIED_LIMBS = ("arms", "neck")
 
 DIAGNOSTICS = VectorLayout(
     ("qp_ok", 1),  # 1 if this tick's QP succeeded, else 0 (torques held)
@@ -148,13 +151,7 @@ def _tasks(
             layout, contact_map, plant.gravity_field().gravity_vector(), config.momentum_weight
         ),
         CopCenteringTask(layout, contacts, config.cop_centering_weight),
-        posture(
-            PostureTask,
-            weights(
-                config.posture_weight_by_joint, "posture_weight_by_joint", config.posture_weight
-            ),
-            "posture",
-        ),
+        posture(PostureTask, posture_weights(plant, joints, config), "posture"),
         posture(
             PostureTask,
             weights(config.stance_posture_weight_by_joint, "stance_posture_weight_by_joint", 0.0),
@@ -174,6 +171,30 @@ def _tasks(
             config.base_orientation_damping_ratio,
         ),
     ]
+
+
+def posture_weights(plant: MultibodyPlant, joints: ControllerJoints, config: ControllerConfig):
+    """The posture task's weight per joint: posture_weight_by_joint where it names one;
+    with carried_limb_weight_by_mass, each joint of a limb the trunk carries (the arms, the
+    neck) the torso pitch's weight times the mass the torso carries over the mass that
+    joint carries; posture_weight elsewhere."""
+    table = config.posture_weight_by_joint
+    w = joint_values(joints.names, table, "posture_weight_by_joint", config.posture_weight)
+    if not config.carried_limb_weight_by_mass or "torso_pitch" not in joints.names:
+        return w
+    carried = {name: _carried_mass_kg(plant, joints.instance, name) for name in joints.names}
+    w_torso = w[joints.names.index("torso_pitch")]
+    for i, name in enumerate(joints.names):
+        if name not in table and joint_group(name) in CARRIED_LIMBS:
+            w[i] = w_torso * carried["torso_pitch"] / carried[name]
+    return w
+
+
+def _carried_mass_kg(plant: MultibodyPlant, instance, joint_name: str) -> float:
+    """The mass of the bodies a joint moves (its outboard subtree), kg, the model's."""
+    joint = plant.GetJointByName(joint_name, instance)
+    bodies = plant.GetBodiesKinematicallyAffectedBy([joint.index()])
+    return sum(plant.get_body(body).default_mass() for body in bodies)
 
 
 def _partially_held(

@@ -73,6 +73,7 @@ class ControllerJoints:
     v_indices: np.ndarray  # index of each joint's rate in v
     q_min: np.ndarray  # position limits, rad
     q_max: np.ndarray
+    instance: object = None  # the robot's ModelInstanceIndex
 
     @classmethod
     def of(cls, plant: MultibodyPlant, robot: Robot) -> ControllerJoints:
@@ -84,6 +85,7 @@ class ControllerJoints:
             v_indices=actuated.v_index,
             q_min=np.array([joint.position_lower_limits()[0] for joint in joints]),
             q_max=np.array([joint.position_upper_limits()[0] for joint in joints]),
+            instance=robot.model_instance,
         )
 
 
