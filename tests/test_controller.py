@@ -98,6 +98,7 @@ class _Rig:
             self.config,
             modes=(1, 2, 3, 4),
             stance_modes={k for k, phase in enumerate(self.table, start=1) if phase.stance},
+            period_s=PERIOD_S,
         )
         self.system = StandupWholeBodyController(
             self.schedule,
@@ -894,3 +895,56 @@ def test_carried_limbs_weigh_by_the_mass_they_carry(scene):
     flat = dataclasses.replace(config, carried_limb_weight_by_mass=False)
     w_flat = dict(zip(joints.names, posture_weights(plant, joints, flat), strict=True))
     assert w_flat["r_elbow"] == config.posture_weight and w_flat["l_elbow"] == 0.5
+
+
+def test_released_thigh_pads_plan_on_their_dynamics(scene):
+    """controller.seat_pad_dynamics: while the thighs' load is released (state 3, their
+    normal held), each thigh's planned normal force is what its pad gives for the planned
+    motion, f_z + (k T^2 / 6) a_n = F measured (control/pad_dynamics.py (2)), with a_n from
+    Drake's Jacobian and bias acceleration and k from the pad's tilt; without it the
+    thighs have no compliance."""
+    scene, x0 = scene
+    plant, robot = scene.plant, scene.robot
+    instance = robot.model_instance
+    context = plant.CreateDefaultContext()
+    rng = np.random.default_rng(46)
+    measured = np.array([0.0, 40.0, 25.0])
+    for dynamics in (True, False):
+        rig = _Rig(scene, seat_pad_dynamics=dynamics, torque_limit_Nm=1000.0)
+        pads = {spec.frame: spec.compliance for spec in rig.specs}
+        for _ in range(10):
+            x = _random_state(plant, instance, x0, rng)
+            com = _com(plant, instance, x)
+            loads = [0.0, 0.5, 0.5]
+            rig.fix(x, np.concatenate([com, np.zeros(6)]), 3, loads=loads)
+            mode = dataclasses.replace(initial_mode(np.zeros(3)), state=3)
+            rig.schedule.commands = contact_commands(
+                rig.config,
+                np.array(loads),
+                np.full(3, 100.0),
+                measured,
+                phase_seat_hold(mode, rig.table),
+            )
+            solution = rig.tick()
+            assert solution.ok and not solution.relaxed
+            plant.SetPositionsAndVelocities(context, instance, x)
+            for k, name in enumerate(("l_thigh", "r_thigh"), start=1):
+                frame = robot.frame(plant, name)
+                J = plant.CalcJacobianSpatialVelocity(
+                    context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
+                )
+                bias = plant.CalcBiasSpatialAcceleration(
+                    context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
+                ).get_coeffs()
+                a_n = J[5] @ solution.vdot + bias[5]
+                f_z = solution.F_C[solution.frames.index(name), 5]
+                if not dynamics:
+                    assert pads[name] is None
+                    continue
+                R_WC = frame.CalcPoseInWorld(context).rotation().matrix()
+                tilt = np.arccos(np.clip(R_WC[2, 2], -1.0, 1.0))
+                rolled = abs(R_WC[2, 1]) > abs(R_WC[2, 0])
+                stiffness = pads[name].stiffness_N_per_m(measured[k], tilt, rolled)
+                assert f_z + stiffness * PERIOD_S**2 / 6 * a_n == pytest.approx(
+                    measured[k], abs=1e-6
+                )

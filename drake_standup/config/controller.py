@@ -97,6 +97,10 @@ class ControllerConfig:
     # this (standup/contact_schedule.py): the QP planned on more than the compliant pads
     # carried, and on a low seat leaned on thighs that carried nothing. N.
     seat_measured_margin_N: float = 20.0
+    # While a thigh's load is released, the QP plans on the force its compliant pad gives
+    # for the thigh's planned motion (control/pad_dynamics.py), not on any force up to the
+    # bound above (it sat on that bound). Off: measured, the slaps stay (the pads ring).
+    seat_pad_dynamics: bool = False
     # Sole normal-force bound: three times the robot's weight, never binding. N.
     foot_max_normal_force_N: float = 1000.0
     # CoP box of each sole in its l_sole/r_sole frame (SPEC 3; inside the 0.19 x 0.09 m

@@ -39,6 +39,9 @@ class ContactSpec:
     # (wrench_cone_matrix): the soles, which give it through their own pad alone. The
     # seated pelvis also turns on the thighs' lever arm, which its box does not see.
     rectangle_yaw: bool = False
+    # A seat pad's normal compliance (control/pad_dynamics.py: PadCompliance): while its
+    # normal is held, the QP plans on the force the pad gives for the motion it plans.
+    compliance: object = None
 
     @property
     def components(self) -> slice:
@@ -152,3 +155,5 @@ class ContactCommands:
     seat_hold: str  # HOLDS: the seat's rows held (all, all but the hip pitch, none)
     # The thighs' rows held: none (free), their normal (normal) or their pitch too (flat).
     thighs_hold: str = "free"
+    # The seat pads' measured normal forces (5,: NaN where not measured), N.
+    measured_normal_force_N: np.ndarray | None = None

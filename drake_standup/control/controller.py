@@ -84,6 +84,7 @@ def make_program(
     stance_states: set[int],
     torque_limit_Nm: float,
     modes: tuple[int, ...],
+    period_s: float = 0.0,
 ) -> Program:
     """The QP over the active contacts with the controller's tasks (control/tasks/):
     momentum, CoP centering, posture; in the stance states the legs' posture and the
@@ -112,6 +113,7 @@ def make_program(
         soft_bound_weight=config.joint_limit_weight,
         solver=config.qp_solver,
         contact_velocity_gain_per_s=config.contact_velocity_gain_per_s,
+        pad_period_s=period_s,
     )
     return Program(
         qp=qp,
@@ -248,9 +250,11 @@ class WholeBodyController:
         config: ControllerConfig,
         modes: tuple[int, ...],
         stance_modes: set[int],
+        period_s: float = 0.0,
     ):
         """modes: the values TaskReferences.standup_state takes; stance_modes: those in
-        which the stance tasks act."""
+        which the stance tasks act; period_s: the control period (0: no seat pad rows,
+        control/pad_dynamics.py)."""
         if [spec.frame for spec in specs] != list(CONTACTS):
             raise ValueError(f"contact specs must be {CONTACTS}")
         actuators = plant.GetJointActuatorIndices()
@@ -259,7 +263,15 @@ class WholeBodyController:
             plant.get_joint_actuator(i).effort_limit() for i in actuators
         )
         self._make = lambda active: make_program(
-            specs, active, plant, joints, config, set(stance_modes), torque_limit, tuple(modes)
+            specs,
+            active,
+            plant,
+            joints,
+            config,
+            set(stance_modes),
+            torque_limit,
+            tuple(modes),
+            period_s,
         )
         self._programs: dict[tuple[bool, ...], Program] = {}
         # The last contact commands and the program's form of them.
@@ -304,6 +316,9 @@ class WholeBodyController:
                     commands.min_normal_force_N[index],
                     commands.max_normal_force_N[index],
                     program.partially_held[(commands.seat_hold, commands.thighs_hold)],
+                    None
+                    if commands.measured_normal_force_N is None
+                    else commands.measured_normal_force_N[index],
                 ),
             )
         solution = program.qp.solve(terms, references, self._last[1])

@@ -18,9 +18,10 @@ from pydrake.multibody.plant import MultibodyPlant
 from drake_standup.config import ControllerConfig
 from drake_standup.control.contacts import CONTACTS, ContactCommands, ContactSpec
 from drake_standup.control.mass import next_mass_state
+from drake_standup.control.pad_dynamics import PadCompliance
 from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.ports.payloads import HAND_WRENCHES
-from drake_standup.robot.icub import Robot, actuated_joints
+from drake_standup.robot.icub import Robot, actuated_joints, load_contact_model
 
 HANDS = ("l_hand", "r_hand")
 _F_Z_LEFT = HAND_WRENCHES["f_l"].start + 2
@@ -28,11 +29,13 @@ _F_Z_RIGHT = HAND_WRENCHES["f_r"].start + 2
 
 
 def contact_specs(
-    plant: MultibodyPlant, robot: Robot, config: ControllerConfig
+    plant: MultibodyPlant, robot: Robot, config: ControllerConfig, chair=None
 ) -> list[ContactSpec]:
     """The controller's contacts (CONTACTS): the seat, held at the hip axis (the mid-point
     of controller.seat_hinge_joints' frames), both thighs (point forces, pinned by the
-    others), both soles; friction and CoP boxes from the config."""
+    others), both soles; friction and CoP boxes from the config; with
+    controller.seat_pad_dynamics, the thighs' pads' compliance on chair's seat
+    (ChairConfig; None: a rigid seat)."""
     seat = robot.frame(plant, "seat")
     context = plant.CreateDefaultContext()
     p_SeatHinge = np.mean(
@@ -52,15 +55,35 @@ def contact_specs(
     seat_box = {"cop_x_m": tuple(config.seat_cop_x_m), "cop_y_m": tuple(config.seat_cop_y_m)}
     thigh_box = {"cop_x_m": tuple(config.thigh_cop_x_m), "cop_y_m": tuple(config.thigh_cop_y_m)}
     foot_box = {"cop_x_m": tuple(config.foot_cop_x_m), "cop_y_m": tuple(config.foot_cop_y_m)}
+    pads = thigh_compliances(robot, chair) if config.seat_pad_dynamics else {}
     return [
         ContactSpec("seat", **friction, **seat_box, hold_point_m=tuple(p_SeatHinge.tolist())),
         # Held once the buttocks are off the seat, while the thighs carry load (flat while
         # seated, by their normal while they unload: standup/contact_schedule.py).
-        ContactSpec("l_thigh", **friction, **thigh_box),
-        ContactSpec("r_thigh", **friction, **thigh_box),
+        ContactSpec("l_thigh", **friction, **thigh_box, compliance=pads.get("l_thigh")),
+        ContactSpec("r_thigh", **friction, **thigh_box, compliance=pads.get("r_thigh")),
         ContactSpec("l_sole", **friction, **foot_box, rectangle_yaw=True),
         ContactSpec("r_sole", **friction, **foot_box, rectangle_yaw=True),
     ]
+
+
+def thigh_compliances(robot: Robot, chair=None) -> dict[str, PadCompliance]:
+    """Each thigh contact's pad compliance (control/pad_dynamics.py) from its box in the
+    contact model and the seat's cushion (chair.cushion; a chair of one's own file is
+    taken as rigid)."""
+    modulus = load_contact_model().hydroelastic_modulus_Pa
+    cushion = None if chair is None or chair.file else chair.cushion
+    seat = (
+        {}
+        if cushion is None
+        else {"seat_modulus_Pa": cushion.modulus_Pa, "seat_thickness_m": cushion.thickness_m}
+    )
+    frames = {robot.TASK_FRAMES[name]: name for name in ("l_thigh", "r_thigh")}
+    return {
+        frames[shape.frame]: PadCompliance.of_box(tuple(shape.size_m), modulus, **seat)
+        for shape in robot.contact_shapes
+        if shape.frame in frames and shape.shape == "box"
+    }
 
 
 @dataclass(frozen=True)

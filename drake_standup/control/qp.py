@@ -15,7 +15,8 @@ The program, built once and refilled every tick:
     min_z  sum_k w_k ||A_k z - b_k||^2 + w_tau ||T z + t0||^2 + w_F ||F||^2 + w_a ||vdot||^2
     s.t.   S_f (M vdot - sum_c G_c F_c) = S_f (J_h^T F_hand - h)     dynamics, base rows
            S_c (J_c vdot + Jdot_c v) = -k S_c J_c v    each held contact (S_c: held rows;
-                                                      k: a slip braked back to rest)
+                                  k: a slip braked back to rest; a thigh pad's normal
+                                  row: its dynamics instead, control/pad_dynamics.py)
            K_c F_c <= 0,  f_z,c in [lo_c, hi_c]       each contact
            -tau_max <= T z + t0 <= tau_max            torque limits
            vdot_min <= vdot <= vdot_max               joint limits, and the shoulders'
@@ -27,18 +28,13 @@ The tasks (A_k, b_k, w_k) are Task objects (control/tasks/), consumed genericall
 ones active in the tick's standup state, each refreshed by its update(); the solver is a
 backend chosen by name (daqp, or Drake's OSQP / Clarabel).
 
-The torque limits rarely bind (never in the default scenario's closed loop): each tick
-first solves without them, and again with them only if the torques come out beyond the
-limits. A solution within the limits is also the optimum with them (the program is
-strictly convex), and daqp solves it 10-20 % faster without their nu rows (measured).
-
-The soft joint-limit rows, one per joint and each with its slack, are likewise left out
-for the joints whose limit is not in play: daqp's cost is its set-up, cubic in the
-unknowns, and a 100-unknown program has 32 of them. The program without a joint's row and
-slack is a relaxation of the full one (a constraint and a non-negative cost term fewer),
-so its optimum is the full program's whenever it keeps that joint's vdot within its bounds
-with no slack: every tick checks that, and solves again with the joints that break it.
-The joints kept are those whose row was in play at the last tick (at a bound or slack).
+The torque limits rarely bind: each tick first solves without them (daqp 10-20 % faster),
+again with them only if the torques come out beyond; a solution within the limits is the
+optimum with them (the program is strictly convex). Likewise the soft joint-limit rows
+(a row and a slack each) are left out for the joints whose limit is not in play: the
+program without them is a relaxation of the full one, so its optimum is the full one's
+whenever it keeps those joints' vdot within bounds unslacked; each tick checks that and
+solves again with the joints that break it. Kept: those in play at the last tick.
 
 daqp's infeasible verdict is wrong on some programs that have a solution (random states
 near a torque limit): where it fails a program, Clarabel solves it before the relaxed
@@ -51,6 +47,7 @@ import numpy as np
 
 from drake_standup.control.backends import make_backend
 from drake_standup.control.contacts import WRENCH_SIZE, wrench_cone_matrix
+from drake_standup.control.pad_dynamics import PadRows
 
 # Other modules and the tests import the QP's types from here too (QpLayout only for them).
 from drake_standup.control.qp_types import (
@@ -95,6 +92,7 @@ class WholeBodyQp:
         soft_bound_weight: float = 0.0,
         solver: str = "daqp",
         contact_velocity_gain_per_s: float = 0.0,
+        pad_period_s: float = 0.0,
     ):
         """contact_map: the active contacts and their map (the tasks may share it).
         tasks: the cost's tasks. modes: the values references.standup_state takes
@@ -135,6 +133,7 @@ class WholeBodyQp:
         self._free_rows: np.ndarray | None = None
         self._acceleration_bounds = acceleration_bounds
         self._make_views(B, rows_acc, rows_dynamics)
+        self._pad_rows = PadRows(self, pad_period_s)  # the seat pads' rows
         self._H_regularisation = np.diag(
             np.concatenate(
                 [
@@ -334,6 +333,7 @@ class WholeBodyQp:
             task.update(terms, references)
         r = self._fill_dynamics(terms, references.tau_hand)
         self._fill_held_contacts(terms, commands.partially_held)
+        self._pad_rows.fill(terms, commands.partially_held, commands.measured_normal_force_N)
         self._fill_bounds(terms, commands)
         r_actuated = r[self._actuated]
         H, g = self._cost(active, r_actuated)

@@ -82,6 +82,8 @@ class QpContactBounds:
     # Constrained contacts that hold only some rows of their hold point's spatial
     # acceleration, in C ([alpha; a]): contact index -> held rows; the others hold all.
     partially_held: dict[int, np.ndarray]
+    # The contacts' measured normal forces (nc,: NaN where not measured; None: none), N.
+    measured_normal_force_N: np.ndarray | None = None
 
 
 @dataclass

@@ -83,12 +83,18 @@ def contact_commands(
         )
         low[CHAIR][seated] = np.minimum(low[CHAIR][seated], carried[seated])
     high[CHAIR][releasing] = bound
+    measured = None
+    if measured_N is not None:
+        measured = np.full(len(CONTACTS), np.nan)
+        # Releasing pads only: the QP's row for their dynamics (control/pad_dynamics.py).
+        measured[CHAIR] = np.where(releasing, measured_N, np.nan)
     return ContactCommands(
         active=(chair, chair, chair, True, True),
         min_normal_force_N=low,
         max_normal_force_N=high,
         seat_hold="free" if seat_off else seat_hold,
         thighs_hold=thighs_hold,
+        measured_normal_force_N=measured,
     )
 
 

@@ -121,7 +121,7 @@ def make_standup_controller(
     config, period_s = scenario.controller, scenario.controller_period_s
     table = plan.table
     g = -plant.gravity_field().gravity_vector()[2]
-    specs = contact_specs(plant, robot, config)
+    specs = contact_specs(plant, robot, config, scenario.chair)
     joints = ControllerJoints.of(plant, robot)
     schedule = PhaseReferences(
         table,
@@ -161,6 +161,7 @@ def make_standup_controller(
                 config,
                 modes=plan.states,
                 stance_modes=plan.stance_states,
+                period_s=period_s,
             ),
             plant.num_multibody_states(robot.model_instance),
             period_s,
