@@ -424,6 +424,18 @@ def test_hold_point_velocity_and_bias_acceleration_by_finite_differences(scene):
             np.testing.assert_allclose(Jdotv_WP, A_WP, atol=1e-5 * max(1.0, np.abs(A_WP).max()))
 
 
+def _jacobian_and_bias_in_frame(plant, context, frame) -> tuple[np.ndarray, np.ndarray]:
+    """Drake's spatial velocity Jacobian of frame's origin and its bias spatial
+    acceleration, both expressed in frame: [alpha; a] = J vdot + bias."""
+    J = plant.CalcJacobianSpatialVelocity(
+        context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
+    )
+    bias = plant.CalcBiasSpatialAcceleration(
+        context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
+    ).get_coeffs()
+    return J, bias
+
+
 @pytest.mark.parametrize(
     ("gain", "thighs", "thigh_rows"),
     [(0.0, math.nan, [1, 5]), (20.0, math.nan, [1, 5]), (20.0, 0.5, [5])],
@@ -457,12 +469,7 @@ def test_held_contacts_brake_their_slip(scene, gain, thighs, thigh_rows):
         v = x[plant.num_positions() :]
         for name in ("l_sole", "r_sole", "l_thigh", "r_thigh"):
             frame = robot.frame(plant, name)
-            J = plant.CalcJacobianSpatialVelocity(
-                context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
-            )
-            bias = plant.CalcBiasSpatialAcceleration(
-                context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
-            ).get_coeffs()
+            J, bias = _jacobian_and_bias_in_frame(plant, context, frame)
             acceleration, velocity = J @ solution.vdot + bias, J @ v
             rows = [0, 1, 2, 3, 4, 5] if "sole" in name else thigh_rows
             np.testing.assert_allclose(
@@ -930,12 +937,7 @@ def test_released_thigh_pads_plan_on_their_dynamics(scene):
             plant.SetPositionsAndVelocities(context, instance, x)
             for k, name in enumerate(("l_thigh", "r_thigh"), start=1):
                 frame = robot.frame(plant, name)
-                J = plant.CalcJacobianSpatialVelocity(
-                    context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
-                )
-                bias = plant.CalcBiasSpatialAcceleration(
-                    context, JacobianWrtVariable.kV, frame, np.zeros(3), plant.world_frame(), frame
-                ).get_coeffs()
+                J, bias = _jacobian_and_bias_in_frame(plant, context, frame)
                 a_n = J[5] @ solution.vdot + bias[5]
                 f_z = solution.F_C[solution.frames.index(name), 5]
                 if not dynamics:

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drake_standup.control.pad_dynamics import PadCompliance
+
 WRENCH_SIZE = 6
 # Index of the normal force f_z in F_C = [tau_x, tau_y, tau_z, f_x, f_y, f_z].
 NORMAL = 5
@@ -41,7 +43,7 @@ class ContactSpec:
     rectangle_yaw: bool = False
     # A seat pad's normal compliance (control/pad_dynamics.py: PadCompliance): while its
     # normal is held, the QP plans on the force the pad gives for the motion it plans.
-    compliance: object = None
+    compliance: PadCompliance | None = None
 
     @property
     def components(self) -> slice:

@@ -64,7 +64,7 @@ class PadCompliance:
     ) -> PadCompliance:
         """A pad of box size_m (x, y, z) and hydroelastic modulus; seat_modulus_Pa: the
         seat's cushion, seat_thickness_m thick (None: a rigid seat)."""
-        length, width, height = size_m
+        length, width, _ = size_m  # the depth is min(size_m), Drake's pressure field's
         compliance = (min(size_m) / 2.0) / modulus_Pa
         if seat_modulus_Pa is not None:
             compliance += (seat_thickness_m / 2.0) / seat_modulus_Pa

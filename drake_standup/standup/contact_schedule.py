@@ -84,7 +84,7 @@ def contact_commands(
         low[CHAIR][seated] = np.minimum(low[CHAIR][seated], carried[seated])
     high[CHAIR][releasing] = bound
     measured = None
-    if measured_N is not None:
+    if measured_N is not None and config.seat_pad_dynamics:
         measured = np.full(len(CONTACTS), np.nan)
         # Releasing pads only: the QP's row for their dynamics (control/pad_dynamics.py).
         measured[CHAIR] = np.where(releasing, measured_N, np.nan)
