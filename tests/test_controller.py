@@ -502,13 +502,14 @@ def test_contacts_cancel_all_but_the_helpful_pull(scene, moving):
     """Seated at rest with x_d = CoM and a 15 N forward + 15 N up pull on each hand:
     with xd_dot = 0 the contacts cancel the whole pull (sum F_c + f_hand + m g = 0);
     with xd_dot along +x they leave the forward 30 N acting (sum F_c,x = m xddot*_x)
-    and cancel the rest. (A momentum weight of 1e4 makes the momentum task all but hard:
-    at the default weight the posture task takes ~1 N of it here.)"""
+    and cancel the rest. (A momentum weight of 1e4 makes the momentum task all but hard
+    against the flat posture weights: at the default weight the posture task takes ~1 N
+    of it here, and with the carried limbs weighed by their mass 0.6 N at 1e4.)"""
     scene, x0 = scene
     plant, robot = scene.plant, scene.robot
     instance = robot.model_instance
     config = ControllerConfig()
-    rig = _Rig(scene, momentum_weight=1e4)
+    rig = _Rig(scene, momentum_weight=1e4, carried_limb_weight_by_mass=False)
     com = _com(plant, instance, x0)
     xd_dot = np.array([0.1, 0.0, 0.0]) if moving else np.zeros(3)
     hands = np.tile([0.0, 0.0, 0.0, 15.0, 0.0, 15.0], 2)
@@ -881,21 +882,23 @@ def _outboard_mass_kg(plant, instance, joint_name):
 
 
 def test_carried_limbs_weigh_by_the_mass_they_carry(scene):
-    """Each arm and neck joint's posture weight is the torso pitch's times the mass the
-    torso carries over the mass the joint carries (each walked out of the tree here); a
-    joint the table names keeps its value; the legs keep posture_weight; off, all flat."""
+    """Each arm and neck joint's posture weight is the torso pitch's times (the mass the
+    torso carries over the mass the joint carries)^exponent (each walked out of the tree
+    here); a joint the table names keeps its value; the legs keep posture_weight; off,
+    all flat."""
     scene_, _ = scene
     plant, robot = scene_.plant, scene_.robot
     joints = ControllerJoints.of(plant, robot)
     config = ControllerConfig(
         posture_weight_by_joint={"torso_pitch": 2.0, "l_elbow": 0.5},
         carried_limb_weight_by_mass=True,
+        carried_limb_weight_exponent=1.5,
     )
     w = dict(zip(joints.names, posture_weights(plant, joints, config), strict=True))
     torso = _outboard_mass_kg(plant, robot.model_instance, "torso_pitch")
     for name in ("r_shoulder_pitch", "r_elbow", "l_wrist_yaw", "neck_pitch"):
-        expected = 2.0 * torso / _outboard_mass_kg(plant, robot.model_instance, name)
-        np.testing.assert_allclose(w[name], expected, rtol=1e-12)
+        ratio = torso / _outboard_mass_kg(plant, robot.model_instance, name)
+        np.testing.assert_allclose(w[name], 2.0 * ratio**1.5, rtol=1e-12)
     assert w["r_wrist_yaw"] > w["r_elbow"] > w["r_shoulder_pitch"] > 2.0  # lighter, dearer
     assert w["l_elbow"] == 0.5 and w["torso_pitch"] == 2.0
     assert w["l_knee"] == config.posture_weight

@@ -63,7 +63,9 @@ def test_assisted_stands_up_sooner(assisted, unassisted):
     assert m["psi_dot_max"] > 1.0
     assert m["psi_dot_max"] <= scenario.advancement.psi_dot_upper
     assert m["psi_final"] > scenario.duration_s  # psi ran ahead of time
-    assert m["standup_time_s"] <= 0.75 * u["standup_time_s"]  # issue 12: 25% sooner
+    # Issue 12 asked 25 % sooner; issue 46 traded some of it for arms that do not whip
+    # (the carried limbs weighed by their mass: 2.85 s against 2.76 s) and asks 20 %.
+    assert m["standup_time_s"] <= 0.80 * u["standup_time_s"]
     # The same scenario with psi = t (the faded reference of the figure).
     assert m["standup_time_s"] < m["standup_time_s_without_advancement"]
 

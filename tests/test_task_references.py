@@ -5,6 +5,7 @@ and the generator's memory over ticks."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from functools import partial
 
@@ -122,7 +123,7 @@ def _calc(
         reference,
         hands,
         np.zeros(3) if integral is None else integral,
-        np.zeros(2 + 2 * nu),
+        np.zeros(2 + 3 * nu),
         lean,
         progress,
         0.0,
@@ -359,18 +360,18 @@ def test_posture_and_lean_filters_run_on_psi(rig, psi_dot):
     np.testing.assert_allclose(on_psi.lean_W, rate * on_time.lean_W, rtol=1e-12)
     nu = len(rig["joints"].names)
     q = rig["x"][rig["joints"].q_indices]
-    step = on_time.next_posture[1 + nu : 1 + 2 * nu] - q
-    np.testing.assert_allclose(
-        on_psi.next_posture[1 + nu : 1 + 2 * nu] - q, rate * step, rtol=1e-9, atol=1e-12
-    )
+    stage = slice(1 + 2 * nu, 1 + 3 * nu)  # the filter's stage that follows the target
+    step = on_time.next_posture[stage] - q
+    np.testing.assert_allclose(on_psi.next_posture[stage] - q, rate * step, rtol=1e-9, atol=1e-12)
     assert np.abs(step).max() > 1e-4 and np.abs(on_time.lean_W).max() > 1e-4
 
 
 def test_the_posture_and_the_base_target_at_the_first_tick(rig):
-    """The first tick latches the posture it starts from; the reference then moves T /
-    tau toward the phase's targets (held joints toward where they are); the base target
-    is upright at the current yaw, pitched forward by the phase's base pitch: the base's
-    up axis tilts toward where the robot faces by that angle."""
+    """The first tick latches the posture it starts from; the filter's first stage then
+    moves T / tau toward the phase's targets (held joints toward where they are) and the
+    reference, its second stage, starts at rest; the base target is upright at the
+    current yaw, pitched forward by the phase's base pitch: the base's up axis tilts
+    toward where the robot faces by that angle."""
     references, _ = _calc(rig, 2)
     joints, schedule = rig["joints"], rig["schedule"]
     q = rig["x"][joints.q_indices]
@@ -380,8 +381,9 @@ def test_the_posture_and_the_base_target_at_the_first_tick(rig):
     blend = T / CONFIG.posture_filter_time_constant_s
     nu = len(q)
     np.testing.assert_allclose(references.q_reference, q, atol=0.0)
+    np.testing.assert_allclose(references.next_posture[1 + nu : 1 + 2 * nu], q, atol=0.0)
     np.testing.assert_allclose(
-        references.next_posture[1 + nu : 1 + 2 * nu], q + blend * (target - q), atol=1e-12
+        references.next_posture[1 + 2 * nu : 1 + 3 * nu], q + blend * (target - q), atol=1e-12
     )
     R_target = references.R_WB_target
     R_WB = rig["kinematics"].calc(rig["x"], []).R_WB
@@ -393,6 +395,47 @@ def test_the_posture_and_the_base_target_at_the_first_tick(rig):
     assert up[2] == pytest.approx(math.cos(TABLE.forward.base_pitch_rad), abs=1e-12)
 
 
+@pytest.mark.parametrize("stages", [1, 2])
+def test_the_posture_filter_steps_as_its_stages_in_series(rig, stages):
+    """Over n ticks toward a state's posture from the latched one, a gap e closes as n
+    first-order stages of blend a = T / tau in series do: one, e (1 - (1 - a)^n), its
+    rate a jump at the switch; two, e (1 - (1 - a)^n - n a (1 - a)^(n - 1)), starting at
+    rest (zero first step) and never faster than (1 - a)^(1/a - 1) e / tau ~ e / (e tau)."""
+    config = dataclasses.replace(CONFIG, posture_filter_stages=stages)
+    generator = ReferenceGenerator(
+        config, rig["schedule"], as_slice(rig["joints"].q_indices), T, rig["g"]
+    )
+    terms = rig["kinematics"].calc(rig["x"], [])
+    p, _, _, _ = _drake_com(rig)
+    schedule, nu = rig["schedule"], len(rig["joints"].names)
+    q = rig["x"][rig["joints"].q_indices]
+    gap = np.where(schedule[2].posture_hold, 0.0, schedule[2].posture_rad - q)
+    a = T / config.posture_filter_time_constant_s
+    posture, references = np.zeros(2 + 3 * nu), []
+    for _ in range(120):
+        tick = generator.calc(
+            terms, 2, np.concatenate([p, np.zeros(6)]), None, np.zeros(3), posture
+        )
+        references.append(tick.q_reference)
+        posture = tick.next_posture
+    n = np.arange(120)[:, None]
+    share = 1.0 - (1.0 - a) ** n
+    if stages == 2:
+        share -= n * a * (1.0 - a) ** np.maximum(n - 1, 0)
+    np.testing.assert_allclose(np.array(references) - q, share * gap, atol=1e-12)
+    rates = np.abs(np.diff(references, axis=0)).max(axis=0) / T
+    first = np.abs(references[1] - references[0]) / T
+    moving = np.abs(gap) > 0.1
+    assert moving.any()
+    if stages == 1:
+        np.testing.assert_allclose(first[moving], np.abs(gap[moving]) * a / T, rtol=1e-9)
+    else:
+        assert first.max() == 0.0
+        bound = np.abs(gap) / (math.e * config.posture_filter_time_constant_s)
+        assert (rates[moving] <= 1.05 * bound[moving]).all()
+        assert (rates[moving] >= 0.95 * bound[moving]).all()  # it reaches its peak
+
+
 def test_the_generator_integrates_the_angular_momentum_over_its_ticks(rig):
     """Four ticks, each from the state the last one left (as the whole-body controller's
     tick keeps it): int L dt = 4 T L (Drake's angular momentum), and the lean stays zero
@@ -400,7 +443,7 @@ def test_the_generator_integrates_the_angular_momentum_over_its_ticks(rig):
     terms = rig["kinematics"].calc(rig["x"], [])
     p, _, L, _ = _drake_com(rig)
     nu = len(rig["generator"].schedule.q_target_min)
-    integral, posture, lean = np.zeros(3), np.zeros(2 + 2 * nu), np.zeros(3)
+    integral, posture, lean = np.zeros(3), np.zeros(2 + 3 * nu), np.zeros(3)
     for _ in range(4):
         references = rig["generator"].calc(
             terms,

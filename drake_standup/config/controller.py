@@ -29,6 +29,10 @@ class ControllerConfig:
     # for large joint accelerations at each switch. On psi's clock, never slower than
     # time (standup/task_references.py). s.
     posture_filter_time_constant_s: float = 0.3
+    # ... in this many first-order stages in series, each of that time constant: one
+    # starts q_ref at its fastest rate (the gap over tau) at every switch; two start it at
+    # rest (docs/design.md, "The limbs the trunk carries"). 1 or 2.
+    posture_filter_stages: int = 2
     # Posture targets are clamped this far inside the joint limits: SPEC 3's elbow target
     # 0.2473 rad lies below the URDF's 0.262 limit. rad.
     posture_limit_margin_rad: float = 0.05
@@ -65,12 +69,13 @@ class ControllerConfig:
         default_factory=lambda: {"torso_pitch": 1.0, "torso_roll": 1.0, "torso_yaw": 1.0}
     )
     # True: the joints of the limbs the trunk carries (arms, neck) not named there weigh
-    # the torso pitch's weight times the mass the torso carries over the mass the joint
-    # carries (6 at a shoulder, 13 at an elbow, 17-64 at a wrist, 9-10 at the neck on
-    # iCubGazeboV2_5). It takes the whip out of the lean (arms 5.3 -> 3.75 rad/s) and keeps
-    # a 30 N pull from toppling the robot, but costs the default run 0.05 s and the
-    # hips' plan fidelity: off until that is mended (docs/design.md, issue 46).
-    carried_limb_weight_by_mass: bool = False
+    # the torso pitch's weight times (the mass the torso carries over the mass the joint
+    # carries) to carried_limb_weight_exponent (the ratio is 6 at a shoulder, 13 at an
+    # elbow, 17-64 at a wrist, 9-10 at the neck on iCubGazeboV2_5): light limbs ride with
+    # the trunk instead of whipping in the lean (docs/design.md, issue 46).
+    carried_limb_weight_by_mass: bool = True
+    # Measured with the two-stage posture filter: 1 left the arms at 3.1 rad/s, 1.5 at 2.5.
+    carried_limb_weight_exponent: float = 1.5
     # Base orientation weight: the pelvis ends upright to 0.3 deg (1.4 deg at 1).
     base_orientation_weight: float = 10.0
     # Each 6-D contact's CoP to the centre of its box (N m): it shares the load, which the

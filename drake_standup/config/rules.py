@@ -33,8 +33,11 @@ class Range:
     low_open: bool = False
     high_open: bool = False
     text: str = ""  # what an error says is accepted, if more than the bounds
+    integer: bool = False  # whole numbers only
 
     def accepts(self, x) -> bool:
+        if self.integer and float(x) != int(x):
+            return False
         above = x > self.low if self.low_open else x >= self.low
         return above and (x < self.high if self.high_open else x <= self.high)
 
@@ -121,6 +124,8 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "simulator.start_time fall.min_root_height_m",
     ),
     (PLANT_STEP, "plant.time_step"),
+    (Range(low=1.0, high=2.0, text="1 or 2", integer=True), "controller.posture_filter_stages"),
+    (Range(high=3.0), "controller.carried_limb_weight_exponent"),
     # How far the hips sit behind the seat's edge, the feet stand in front of it: within
     # a leg's length. m.
     (

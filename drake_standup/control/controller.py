@@ -178,8 +178,8 @@ def _tasks(
 def posture_weights(plant: MultibodyPlant, joints: ControllerJoints, config: ControllerConfig):
     """The posture task's weight per joint: posture_weight_by_joint where it names one;
     with carried_limb_weight_by_mass, each joint of a limb the trunk carries (the arms, the
-    neck) the torso pitch's weight times the mass the torso carries over the mass that
-    joint carries; posture_weight elsewhere."""
+    neck) the torso pitch's weight times (the mass the torso carries over the mass that
+    joint carries) ** carried_limb_weight_exponent; posture_weight elsewhere."""
     table = config.posture_weight_by_joint
     w = joint_values(joints.names, table, "posture_weight_by_joint", config.posture_weight)
     if not config.carried_limb_weight_by_mass or "torso_pitch" not in joints.names:
@@ -188,7 +188,8 @@ def posture_weights(plant: MultibodyPlant, joints: ControllerJoints, config: Con
     w_torso = w[joints.names.index("torso_pitch")]
     for i, name in enumerate(joints.names):
         if name not in table and joint_group(name) in CARRIED_LIMBS:
-            w[i] = w_torso * carried["torso_pitch"] / carried[name]
+            ratio = carried["torso_pitch"] / carried[name]
+            w[i] = w_torso * ratio**config.carried_limb_weight_exponent
     return w
 
 

@@ -20,7 +20,8 @@ reads, each law where its task is:
     the stance         how far the legs end the rise (0-1), from the path's progress
     momentum           xddot*, Ldot*, f_par, the stance's height integral
                        (control/tasks/momentum.py: MomentumLaw)
-    posture            q_ref <- q_ref + (T / tau_f) (q_target - q_ref)
+    posture            q_ref <- q_ref + (T / tau_f) (q_target - q_ref), in
+                       posture_filter_stages such stages in series
                        (control/tasks/posture.py: next_posture_reference)
     base orientation   R_WB* = R(yaw_0, pitch) (control/tasks/base.py: BaseTarget)
 
@@ -149,21 +150,25 @@ class ReferenceGenerator:
         )
         nu = self._nu
         if posture[0] > 0.5:
-            q_initial, q_reference = posture[1 : 1 + nu], posture[1 + nu : 1 + 2 * nu]
+            q_initial = posture[1 : 1 + nu]
+            q_reference, q_stage = posture[1 + nu : 1 + 2 * nu], posture[1 + 2 * nu : 1 + 3 * nu]
             base_yaw = posture[-1]
         else:
-            q_initial = q_reference = terms.q[self._q_joints]
+            q_initial = q_reference = q_stage = terms.q[self._q_joints]
             base_yaw = math.atan2(terms.R_WB[1, 0], terms.R_WB[0, 0])
-        q_next = next_posture_reference(
+        two_stages = self._config.posture_filter_stages == 2
+        # The stage that follows the state's posture: the first of two, or q_ref itself.
+        q_stage_next = next_posture_reference(
             q_initial,
-            q_reference,
+            q_stage if two_stages else q_reference,
             state.posture_hold,
             state.posture_rad,
             self.schedule.q_target_min,
             self.schedule.q_target_max,
             blend,
         )
-        next_posture = np.concatenate((self._latched, q_initial, q_next, (base_yaw,)))
+        q_next = q_reference + blend * (q_stage - q_reference) if two_stages else q_stage_next
+        next_posture = np.concatenate((self._latched, q_initial, q_next, q_stage_next, (base_yaw,)))
         return q_reference, next_posture, base_yaw
 
     def calc(

@@ -80,8 +80,9 @@ class StandupWholeBodyController(LeafSystem):
         self._memory = self.DeclareDiscreteState(ContactSchedule.MEMORY_SIZE)
         self._weighing = self.DeclareDiscreteState(np.array(ControllerModel.INITIAL_WEIGHING))
         self._integral = self.DeclareDiscreteState(3)
-        # [latched flag, state-1 posture (nu), filtered posture reference (nu), base yaw].
-        self._posture = self.DeclareDiscreteState(2 + 2 * nu)
+        # [latched flag, state-1 posture (nu), filtered posture reference (nu), the
+        # filter's first stage (nu), base yaw].
+        self._posture = self.DeclareDiscreteState(2 + 3 * nu)
         self._lean = self.DeclareDiscreteState(3)
         self._height_integral = self.DeclareDiscreteState(1)
         self._compliance = self.DeclareDiscreteState(6)
