@@ -21,7 +21,7 @@ from drake_standup.control.mass import next_mass_state
 from drake_standup.control.pad_dynamics import PadCompliance
 from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.ports.payloads import HAND_WRENCHES
-from drake_standup.robot.icub import Robot, actuated_joints, load_contact_model
+from drake_standup.robot.icub import Robot, actuated_joints
 
 HANDS = ("l_hand", "r_hand")
 _F_Z_LEFT = HAND_WRENCHES["f_l"].start + 2
@@ -68,10 +68,10 @@ def contact_specs(
 
 
 def thigh_compliances(robot: Robot, chair=None) -> dict[str, PadCompliance]:
-    """Each thigh contact's pad compliance (control/pad_dynamics.py) from its box in the
-    contact model and the seat's cushion (chair.cushion; a chair of one's own file is
-    taken as rigid)."""
-    modulus = load_contact_model().hydroelastic_modulus_Pa
+    """Each thigh contact's pad compliance (control/pad_dynamics.py) from its box and
+    modulus in the robot's contact model and the seat's cushion (chair.cushion; a chair of
+    one's own file is taken as rigid)."""
+    modulus = robot.contact_modulus_Pa
     cushion = None if chair is None or chair.file else chair.cushion
     seat = (
         {}

@@ -167,6 +167,7 @@ class Robot:
     contact_geometries: dict[str, GeometryId]  # contact geometry name -> id
     contact_shapes: list[ContactShape]
     leaf_frames: list[LeafFrame]
+    contact_modulus_Pa: float  # the contact shapes' hydroelastic modulus
 
     # Task frame -> model frame: the controller speaks of hands and soles. The table lives
     # in config, whose validate checks that a model has these frames (scene_frames).
@@ -214,6 +215,7 @@ def add_icub(
         geometries,
         list(contact.shapes),
         prepared.leaf_frames,
+        contact.hydroelastic_modulus_Pa,
     )
 
 
