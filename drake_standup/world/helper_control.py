@@ -18,7 +18,8 @@
   The trunk is not dragged along but moves on its own: its flexion's set-point is the
   bend it takes to hold hands as high as they started plus the robot's CoM rise as the
   person saw it reaction_time_s ago, carried on at the rate seen (helper_body.bend_for):
-  they straighten, leaning back, as the robot comes up. Feeling a pull beyond their
+  they straighten, leaning back, as the robot comes up, at most at their own pace
+  (TRUNK_RATE_RAD_PER_S). Feeling a pull beyond their
   intent's cap (YIELD_LATENCY_S ago) they give way, wholly from twice it: the set-point
   jumps to the posture and moves with it, and the trunk stops straightening. They let go (the
   grip fades over ramp_s, never taken again) once the intent has eased off wholly (the
@@ -76,6 +77,14 @@ YIELD_LATENCY_S = 0.05
 # lag of 30-50 ms (activation 10-20 ms, deactivation 30-60 ms: Zajac 1989, Crit Rev
 # Biomed Eng 17:359); it low-passes the arms' inertia feed-forward. s.
 ACTIVATION_S = 0.04
+# How fast a person straightens their trunk as the robot rises: about a rad/s, their own
+# trunk's flexion in rising from a chair (59 deg in a full-flexion stand-up: "Effect of
+# trunk angle on lower limb joint moment in different strategies of sit-to-stand-to-sit
+# motion", Med Biol Eng Comput 2025) undone within the second or so of a whole stand-up
+# (1.67 s on average: Baer and Ashburn, "Trunk movements in older subjects during
+# sit-to-stand", Arch Phys Med Rehabil 1995). Unbounded, the set-point stepped 0.6 rad
+# after a fast helped rise and drove a relaxed person's back at 3.5 rad/s, to its strength.
+TRUNK_RATE_RAD_PER_S = 1.0
 # The damping of the least-squares map from the grips' motion to the arms' joints. m^2.
 _ARMS_DAMPING = 1e-4
 
@@ -223,7 +232,8 @@ class PersonController(LeafSystem):
         planned = (
             self._bend0 + bend_for(height, self._hands_z0 + rise) - bend_for(height, self._hands_z0)
         )
-        q_d[self._lumbar] += (1.0 - give) * (planned - q_d[self._lumbar])
+        step = TRUNK_RATE_RAD_PER_S * PERCEPTION_PERIOD_S  # at a person's own pace
+        q_d[self._lumbar] += (1.0 - give) * np.clip(planned - q_d[self._lumbar], -step, step)
         # Their grip: held, let go of (never taken again) once the robot is up.
         eased = seen[0] - self._com_z0 >= self._ease_m[1]  # the intent eased off wholly
         if eased or context.get_time() >= self._pull_end_s:
