@@ -15,6 +15,7 @@ from drake_standup.config import EFFORT_LIMIT_NM, ControllerConfig, Scenario
 from drake_standup.control.model import contact_specs
 from drake_standup.control.qp import ContactMap, QpContactBounds, QpLayout, Task, WholeBodyQp
 from drake_standup.control.targets import TaskReferences
+from drake_standup.control.tasks import SoleMomentRateTask
 from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.robot.balance import static_lean
 from drake_standup.world.scene import add_scene, set_seated_state
@@ -97,12 +98,13 @@ class _FixedBounds:
         return self._bounds
 
 
-def _qp(plant, specs, task_states, **bounds):
+def _qp(plant, specs, task_states, more_tasks=(), **bounds):
     """A QP over all contacts with the config's regularisation and, unless task_states is
-    None, a _JointAcceleration task active in those states."""
+    None, a _JointAcceleration task active in those states; then more_tasks."""
     config = ControllerConfig()
     contact_map = ContactMap(specs, plant.num_velocities())
     tasks = [] if task_states is None else [_JointAcceleration(contact_map.layout, *task_states)]
+    tasks += list(more_tasks)
     return WholeBodyQp(
         contact_map,
         plant.MakeActuationMatrix(),
@@ -238,3 +240,62 @@ def test_an_infeasible_program_falls_back_to_the_relaxed_one(seated):
     # A feasible program is not relaxed.
     fine = QpContactBounds(np.full(nc, 10.0), np.full(nc, 1000.0), {})
     assert not _qp(plant, specs, None).solve(terms, _references(2), fine).relaxed
+
+
+def _with_rate(plant, specs, k, weight_s):
+    """A QP whose _JointAcceleration task acts in state 2, with the soles' moment rate."""
+    layout = ContactMap(specs, plant.num_velocities()).layout
+    rate = SoleMomentRateTask(layout, specs, weight_s, period_s=0.004)
+    return _qp(plant, specs, (k, (2,)), more_tasks=[rate]), rate
+
+
+def test_the_sole_moment_rate_picks_the_moments_over_the_cop_box():
+    """S picks each sole's moments over l, the half of the CoP box's longer side: the
+    soles' box is [-0.05, 0.10] x [-0.025, 0.025] m (controller defaults), l = 0.075."""
+    plant, specs, _, _ = seated_state()
+    layout = ContactMap(specs, plant.num_velocities()).layout
+    task = SoleMomentRateTask(layout, specs, 0.04, period_s=0.004)
+    expected = np.zeros((6, 12))
+    expected[0:3, 0:3] = expected[3:6, 6:9] = np.eye(3) / 0.075
+    np.testing.assert_allclose(task.A, expected)
+    frames = [spec.frame for spec in specs]
+    assert task.columns == slice(layout.wrench(frames.index("l_sole")).start, layout.n_wrench)
+    task.set_last(np.full(12, np.nan))
+    assert task.weight == 0.0
+    task.set_last(np.ones(12))
+    assert task.weight == pytest.approx(0.04 / 0.004)
+    np.testing.assert_allclose(task.b, expected @ np.ones(12))
+
+
+def test_the_sole_moment_rate_pulls_the_soles_cops_toward_the_last_tick():
+    """Without a last tick the task changes nothing, bit for bit; with one, the soles'
+    moments move toward it as its weight grows (a proximal term: monotone in the weight,
+    reaching it in the limit), while the task that changed the plan is still met."""
+    plant, specs, terms, k = seated_state()
+    nc = len(specs)
+    commands = QpContactBounds(np.full(nc, 10.0), np.full(nc, 1000.0), {})
+    frames = [spec.frame for spec in specs]
+    soles = [frames.index("l_sole"), frames.index("r_sole")]
+    # The last tick: state 1, where the joint task is off; this one: state 2.
+    qp, rate = _with_rate(plant, specs, k, 0.04)
+    rate.set_last(np.full(12, np.nan))
+    last = qp.solve(terms, _references(1), commands).F_C[soles].ravel()
+    free = qp.solve(terms, _references(2), commands)
+    reference = _qp(plant, specs, (k, (2,))).solve(terms, _references(2), commands)
+    np.testing.assert_array_equal(free.F_C, reference.F_C)
+    S = rate.A
+
+    def gap(F):
+        return np.linalg.norm(S @ (F[soles].ravel() - last))
+
+    assert gap(free.F_C) > 1.0  # the joint task moved the soles' CoPs (N)
+    gaps = []
+    for weight_s in (0.004, 0.04, 0.4, 40.0):
+        qp, rate = _with_rate(plant, specs, k, weight_s)
+        rate.set_last(last)
+        solution = qp.solve(terms, _references(2), commands)
+        assert solution.ok
+        assert abs(solution.vdot[k] - TARGET_RAD_PER_S2) < 1e-2 * TARGET_RAD_PER_S2
+        gaps.append(gap(solution.F_C))
+    assert all(a > b for a, b in zip([gap(free.F_C)] + gaps, gaps))
+    assert gaps[-1] < 0.01 * gap(free.F_C)

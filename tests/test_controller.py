@@ -325,6 +325,33 @@ def test_static_seated_reference_balances_gravity(scene):
     assert np.all(solution.F_C[:, 5] >= ControllerConfig().min_normal_force_N - 1e-6)
 
 
+def test_the_soles_moment_rate_reads_the_last_tick_from_the_state(scene):
+    """controller.sole_moment_rate_weight_s: the system keeps the soles' planned wrenches
+    of each solved tick in its state (NaN before the first), and the next tick's soles'
+    moments move less from them than without the rate when the CoM reference jumps."""
+    scene, x0 = scene
+    plant, instance = scene.plant, scene.robot.model_instance
+    com = _com(plant, instance, x0)
+    moved = []
+    for weight_s in (0.0, 0.01):
+        rig = _Rig(scene, sole_moment_rate_weight_s=weight_s)
+        rig.fix(x0, np.concatenate([com, np.zeros(6)]), 1)
+        system, context = rig.system, rig.context
+        index = system._sole_wrenches
+        assert np.isnan(context.get_discrete_state(index).value()).all()
+        first = system.calc_tick(context)[0]
+        context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+        np.testing.assert_array_equal(
+            context.get_discrete_state(index).value(), first.sole_wrenches.ravel()
+        )
+        rig.fix(x0, np.concatenate([com + [0.02, 0.0, 0.0], np.zeros(6)]), 1)
+        second = system.calc_tick(context)[0]
+        assert second.solution.ok
+        moved.append(np.abs(second.sole_wrenches[:, :3] - first.sole_wrenches[:, :3]).max())
+    assert moved[0] > 0.1  # N m: the reference's jump moves the soles' CoPs
+    assert moved[1] < 0.5 * moved[0]
+
+
 # --- (c) the centroidal identities the controller relies on -------------------------------
 
 

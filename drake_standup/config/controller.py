@@ -81,6 +81,10 @@ class ControllerConfig:
     # Each 6-D contact's CoP to the centre of its box (N m): it shares the load, which the
     # momentum task leaves free, away from the box edges where a compliant pad rolls.
     cop_centering_weight: float = 1.0e-2
+    # The soles' moments near the last tick's: w ||(tau - tau_last) / l||^2 at w = this /
+    # the control period (control/tasks/moment_rate.py; 0: none). A compliant sole cannot
+    # follow a CoP moved across its box within a few ticks: its heel slapped down. s.
+    sole_moment_rate_weight_s: float = 0.0
     # Regularisation: joint torques (N m), contact wrenches (N, N m), accelerations; they
     # make the Hessian positive definite.
     torque_weight: float = 1.0e-4

@@ -113,7 +113,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
         "human.reactive.ease_com_rise_m advancement.alpha_*_mps2 advancement.lag_tolerance_m "
         "standup.*_s standup.*_N phases.*.unload_s phases.*.exit.* phases.*.com_kp_per_s2 "
-        "controller.*_weight controller.contact_velocity_gain_per_s "
+        "controller.*_weight controller.*_weight_s controller.contact_velocity_gain_per_s "
         "controller.*weight_by_joint.* controller.*_kp_* controller.*_kd_* controller.*_ki_* "
         "controller.*_damping_ratio controller.posture_limit_margin_rad controller.*_N "
         "compliance.damping_ratio compliance.max_offset_m "

@@ -39,6 +39,7 @@ from drake_standup.control.tasks import (
     JointLimitBounds,
     MomentumTask,
     PostureTask,
+    SoleMomentRateTask,
     StancePostureTask,
 )
 from drake_standup.control.terms import RobotTerms
@@ -73,6 +74,10 @@ class Program:
     contact_index: np.ndarray  # of each of its contacts in CONTACTS
     # (HOLDS, THIGH_HOLDS) -> ContactCommands'
     partially_held: dict[tuple[str, str], dict[int, np.ndarray]]
+    # The soles' moment-rate task, whose last wrenches the caller gives (None: none).
+    moment_rate: SoleMomentRateTask | None = None
+    # The soles' rows in the program's contacts (F_C).
+    soles: tuple[int, int] = (0, 0)
 
 
 def make_program(
@@ -91,6 +96,7 @@ def make_program(
     arms' (growing with the stance); base orientation; soft joint-limit bounds."""
     contacts = [spec for spec, on in zip(specs, active, strict=True) if on]
     contact_map = ContactMap(contacts, plant.num_velocities())
+    tasks = _tasks(contacts, contact_map, plant, joints, config, stance_states, period_s)
     qp = WholeBodyQp(
         contact_map,
         plant.MakeActuationMatrix(),
@@ -98,7 +104,7 @@ def make_program(
         torque_weight=config.torque_weight,
         wrench_weight=config.wrench_weight,
         acceleration_weight=config.acceleration_weight,
-        tasks=_tasks(contacts, contact_map, plant, joints, config, stance_states),
+        tasks=tasks,
         modes=modes,
         soft_bounds=JointLimitBounds(
             joints.q_indices,
@@ -115,10 +121,13 @@ def make_program(
         contact_velocity_gain_per_s=config.contact_velocity_gain_per_s,
         pad_period_s=period_s,
     )
+    frames = [spec.frame for spec in contacts]
     return Program(
         qp=qp,
         contact_index=np.array([CONTACTS.index(spec.frame) for spec in contacts]),
         partially_held=_partially_held(contacts),
+        moment_rate=next((t for t in tasks if isinstance(t, SoleMomentRateTask)), None),
+        soles=tuple(frames.index(sole) for sole in ("l_sole", "r_sole")),
     )
 
 
@@ -129,8 +138,10 @@ def _tasks(
     joints: ControllerJoints,
     config: ControllerConfig,
     stance_states: set[int],
+    period_s: float = 0.0,
 ) -> list:
-    """The program's tasks, in the order the QP adds their costs."""
+    """The program's tasks, in the order the QP adds their costs (the soles' moment rate
+    only with a control period and a weight)."""
     layout = contact_map.layout
 
     def weights(table: dict[str, float], key: str, default: float) -> np.ndarray:
@@ -172,7 +183,11 @@ def _tasks(
             config.base_orientation_kp_per_s2,
             config.base_orientation_damping_ratio,
         ),
-    ]
+    ] + (
+        [SoleMomentRateTask(layout, contacts, config.sole_moment_rate_weight_s, period_s)]
+        if config.sole_moment_rate_weight_s > 0.0 and period_s > 0.0
+        else []
+    )
 
 
 def posture_weights(plant: MultibodyPlant, joints: ControllerJoints, config: ControllerConfig):
@@ -237,6 +252,8 @@ class ControllerTick:
     inputs_s: float  # evaluating the references and commands (and the systems behind them)
     kinematics_s: float  # evaluating the terms (the model, and the systems behind it)
     assembly_s: float  # the QP's tasks and matrices
+    # (2, 6) the soles' planned wrenches in their frames, [tau; f] (l_sole, r_sole).
+    sole_wrenches: np.ndarray | None = None
 
 
 class WholeBodyController:
@@ -306,9 +323,16 @@ class WholeBodyController:
         commands: ContactCommands,
         inputs_s: float = 0.0,
         kinematics_s: float = 0.0,
+        last_sole_wrenches: np.ndarray | None = None,
     ) -> ControllerTick:
-        """This tick's QP; inputs_s, kinematics_s: what making its inputs took."""
+        """This tick's QP; inputs_s, kinematics_s: what making its inputs took;
+        last_sole_wrenches: the soles' wrenches of the last solved tick (ControllerTick.
+        sole_wrenches; NaN or None: none), for the moment-rate task."""
         program = self.program(commands.active)
+        if program.moment_rate is not None:
+            program.moment_rate.set_last(
+                np.full(12, np.nan) if last_sole_wrenches is None else last_sole_wrenches
+            )
         index = program.contact_index
         if commands is not self._last[0]:  # the schedule's constant commands repeat
             self._last = (
@@ -331,6 +355,7 @@ class WholeBodyController:
             inputs_s=inputs_s,
             kinematics_s=kinematics_s,
             assembly_s=solution.assembly_s,
+            sole_wrenches=solution.F_C[list(program.soles)],
         )
 
 

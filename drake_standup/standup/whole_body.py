@@ -20,7 +20,7 @@ Outputs: actuation (nu, N m, zero-order held), diagnostics (control/controller.p
 DIAGNOSTICS), lean_W (3, m), compliance_W (6: the admittance's offset and rate, m, m/s),
 mass_estimate (1: the weighing's estimate after the last tick).
 Discrete state: the schedule's memory, the weighing, the references' integrals, posture
-filter, lean and admittance, the torques and the diagnostics.
+filter, lean and admittance, the torques, the soles' planned wrenches and the diagnostics.
 """
 
 from __future__ import annotations
@@ -87,6 +87,8 @@ class StandupWholeBodyController(LeafSystem):
         self._height_integral = self.DeclareDiscreteState(1)
         self._compliance = self.DeclareDiscreteState(6)
         self._actuation = self.DeclareDiscreteState(nu)
+        # The soles' planned wrenches of the last solved tick (2 x 6; NaN: none yet).
+        self._sole_wrenches = self.DeclareDiscreteState(np.full(12, np.nan))
         self._diagnostics = self.DeclareDiscreteState(DIAGNOSTICS.size)
         self.DeclareStateOutputPort("actuation", self._actuation)
         self.DeclareStateOutputPort("diagnostics", self._diagnostics)
@@ -162,6 +164,7 @@ class StandupWholeBodyController(LeafSystem):
             commands,
             inputs_s=time.perf_counter() - t_terms,
             kinematics_s=t_terms - t_start,
+            last_sole_wrenches=state.get_value(self._sole_wrenches),
         )
         return tick, [
             (self._memory, memory),
@@ -180,6 +183,7 @@ class StandupWholeBodyController(LeafSystem):
             discrete_state.set_value(index, value)
         if tick.solution.ok:  # on failure the last torques stay
             discrete_state.set_value(self._actuation, tick.solution.tau)
+            discrete_state.set_value(self._sole_wrenches, tick.sole_wrenches.ravel())
         total_s = time.perf_counter() - t_start
         before = context.get_discrete_state(self._diagnostics).value()
         discrete_state.set_value(self._diagnostics, next_diagnostics(before, tick, total_s))

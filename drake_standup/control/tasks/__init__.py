@@ -9,6 +9,7 @@ refreshed by update(terms, references) from one tick's TaskReferences
     posture.py        qddot = qddot* = -K_P (q - q_ref) - K_D qdot   (the q_ref filter)
     base.py           wdot_WB = wdot* = -K_P theta k - K_D w_WB      (BaseTarget: R_WB*)
     cop.py            (CoP_c - c) f_z,c = 0 for each 6-D contact (constant)
+    moment_rate.py    (tau_sole - tau_sole,last) / l = 0: the soles' CoPs near the last tick's
     joint_limits.py   soft bounds on vdot that keep q in its limits
 
 The hands' measured wrench F_hand acts on the robot in full (it is in the dynamics rows of
@@ -22,6 +23,7 @@ from drake_standup.control.tasks.joint_limits import (
     JointLimitBounds,
     joint_limit_acceleration_bounds,
 )
+from drake_standup.control.tasks.moment_rate import SoleMomentRateTask
 from drake_standup.control.tasks.momentum import (
     MomentumLaw,
     MomentumTarget,
@@ -45,6 +47,7 @@ __all__ = [
     "MomentumTarget",
     "MomentumTask",
     "PostureTask",
+    "SoleMomentRateTask",
     "StancePostureTask",
     "com_acceleration_reference",
     "helpful_force",
