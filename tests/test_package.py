@@ -100,3 +100,14 @@ def test_the_wheel_installs_and_runs_from_an_empty_folder(tmp_path):
     )
     assert str(tmp_path / "venv") in listed  # read from the installed package, not the checkout
     assert sorted(p.name for p in work.iterdir()) == ["X", "Y"]
+
+
+@pytest.mark.parametrize(("given", "expected"), [(None, "1"), ("3", "3")])
+def test_one_blas_thread_per_process_unless_the_user_says(given, expected):
+    """Importing drake_standup (before numpy) asks OpenBLAS for one thread, and a user's
+    own OPENBLAS_NUM_THREADS wins (docs/performance.md: threads spun on a busy machine)."""
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    code = "import drake_standup, os, numpy; print(os.environ['OPENBLAS_NUM_THREADS'])"
+    assert _run([sys.executable, "-c", code], REPO, env, 60.0).strip() == expected
