@@ -25,6 +25,7 @@ from drake_standup.control.contacts import (
     CONTACTS,
     HOLDS,
     NORMAL,
+    SOLES,
     THIGH_HOLDS,
     WRENCH_SIZE,
     ContactCommands,
@@ -127,7 +128,7 @@ def make_program(
         contact_index=np.array([CONTACTS.index(spec.frame) for spec in contacts]),
         partially_held=_partially_held(contacts),
         moment_rate=next((t for t in tasks if isinstance(t, SoleMomentRateTask)), None),
-        soles=tuple(frames.index(sole) for sole in ("l_sole", "r_sole")),
+        soles=tuple(frames.index(sole) for sole in CONTACTS[SOLES]),
     )
 
 

@@ -116,6 +116,8 @@ class PersonController(LeafSystem):
         # The set-point's time constant and its step toward the posture per update.
         self._yield_s = YIELD_TIME_S[helper.config.tone]
         self._follow = min(1.0, PERCEPTION_PERIOD_S / self._yield_s)
+        # The trunk set-point's largest step per update, at a person's own pace.
+        self._trunk_step = TRUNK_RATE_RAD_PER_S * PERCEPTION_PERIOD_S
         # When they let go: as the intent eases off (the robot's CoM rising through
         # ease_com_rise_m as they saw it), or over ramp_s once the pull's time is over.
         self._ease_m = reactive.ease_com_rise_m
@@ -232,7 +234,7 @@ class PersonController(LeafSystem):
         planned = (
             self._bend0 + bend_for(height, self._hands_z0 + rise) - bend_for(height, self._hands_z0)
         )
-        step = TRUNK_RATE_RAD_PER_S * PERCEPTION_PERIOD_S  # at a person's own pace
+        step = self._trunk_step
         q_d[self._lumbar] += (1.0 - give) * np.clip(planned - q_d[self._lumbar], -step, step)
         # Their grip: held, let go of (never taken again) once the robot is up.
         eased = seen[0] - self._com_z0 >= self._ease_m[1]  # the intent eased off wholly

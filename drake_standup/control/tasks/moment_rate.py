@@ -20,10 +20,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from drake_standup.control.contacts import WRENCH_SIZE, ContactSpec
+from drake_standup.control.contacts import CONTACTS, SOLES, WRENCH_SIZE, ContactSpec
 from drake_standup.control.qp_types import QpLayout, Task
 
-SOLES = ("l_sole", "r_sole")
+SOLE_FRAMES = CONTACTS[SOLES]  # ("l_sole", "r_sole")
 
 
 class SoleMomentRateTask(Task):
@@ -37,12 +37,12 @@ class SoleMomentRateTask(Task):
         self, layout: QpLayout, contacts: list[ContactSpec], weight_s: float, period_s: float
     ):
         frames = [spec.frame for spec in contacts]
-        soles = [frames.index(sole) for sole in SOLES]
+        soles = [frames.index(sole) for sole in SOLE_FRAMES]
         if soles != [soles[0], soles[0] + 1]:
             raise ValueError("the soles must be consecutive contacts")
         first, last = layout.wrench(soles[0]), layout.wrench(soles[1])
         self.columns = slice(first.start, last.stop)
-        self.A = np.zeros((3 * len(SOLES), WRENCH_SIZE * len(SOLES)))
+        self.A = np.zeros((3 * len(SOLE_FRAMES), WRENCH_SIZE * len(SOLE_FRAMES)))
         for k, c in enumerate(soles):
             spec = contacts[c]
             half = max(np.ptp(spec.cop_x_m), np.ptp(spec.cop_y_m)) / 2.0
@@ -54,7 +54,7 @@ class SoleMomentRateTask(Task):
     def set_last(self, F_last: np.ndarray) -> None:
         """The soles' wrenches of the last tick, (2, 6) in their frames, [tau; f] (NaN:
         none)."""
-        F_last = np.asarray(F_last, dtype=float).reshape(WRENCH_SIZE * len(SOLES))
+        F_last = np.asarray(F_last, dtype=float).reshape(WRENCH_SIZE * len(SOLE_FRAMES))
         if np.all(np.isfinite(F_last)):
             self.weight = self._weight
             self.b = self.A @ F_last
