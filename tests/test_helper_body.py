@@ -13,7 +13,7 @@ from drake_standup.config import SCENARIO_DIR, load_scenario
 from drake_standup.config.body import BodyHelperConfig
 from drake_standup.outputs.signals import make_signals
 from drake_standup.sim.runner import advance, prepare
-from drake_standup.world.helper_body import (
+from drake_standup.helper.body import (
     JOINT_IMPEDANCE,
     grip_frames,
     joint_names,
@@ -22,7 +22,7 @@ from drake_standup.world.helper_body import (
 )
 
 BODY = SCENARIO_DIR / "body.yaml"
-# The cited maxima, N m, of the people the studies measured (helper_body.py): shoulder
+# The cited maxima, N m, of the people the studies measured (helper/body.py): shoulder
 # flexion at 45 deg 68.6 and abduction 48 for 75 kg; elbow extension 0.67 per kg; wrist
 # extension 7.1 for 75 kg; trunk extension 504 N at 0.4 m for 72.7 kg.
 CITED = {

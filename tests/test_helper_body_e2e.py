@@ -12,7 +12,7 @@ import pytest
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
 from drake_standup.sim.simulate import simulate
-from drake_standup.world.helper_control import TRUNK_RATE_RAD_PER_S
+from drake_standup.helper.body_control import TRUNK_RATE_RAD_PER_S
 
 pytestmark = pytest.mark.slow
 

@@ -22,8 +22,8 @@ from drake_standup.config import (
     parse_scenario,
 )
 from drake_standup.sim.diagram import build_diagram
-from drake_standup.world.human import HumanWrenchSource
-from drake_standup.world.partner import Path, path_force, reactive_force, trapezoid
+from drake_standup.helper.hands import HumanWrenchSource
+from drake_standup.helper.partner import Path, path_force, reactive_force, trapezoid
 
 PULLS = [
     Pull(hand="left", start_s=1.0, duration_s=2.0, ramp_s=0.5, force_N=[20.0, 0.0, 10.0]),
@@ -459,7 +459,7 @@ def test_a_steady_motion_is_tracked_without_the_reaction_times_lag():
     they saw on to now (predicted) and pulls exactly as a person who sees it now; a
     hand that has just stopped where they expect it is pulled on by their damping about
     the speed they still expect, D v = 10 x 0.5 = 5 N along u."""
-    from drake_standup.world.human import PERCEIVED, predicted
+    from drake_standup.helper.hands import PERCEIVED, predicted
 
     cfg, v, lag = _person(), 0.5 * U, 0.2
     now = P0 + 0.3 * U

@@ -118,6 +118,7 @@ LAYERS = (
     "ports",
     "config",
     "robot",
+    "helper",
     "world",
     "control",
     "standup",

@@ -29,7 +29,7 @@ from drake_standup.sim.live import (
     run_session,
 )
 from drake_standup.sim.runner import advance, prepare
-from drake_standup.world.human import HumanWrenchSource
+from drake_standup.helper.hands import HumanWrenchSource
 
 REPO = Path(__file__).resolve().parent.parent
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from pydrake.multibody.plant import MultibodyPlant
 
-from drake_standup.world.person import DE_LEVA_MALE, add_person
+from drake_standup.helper.anthropometry import DE_LEVA_MALE, add_person
 
 PEOPLE = [(1.55, 50.0), (1.90, 100.0)]
 # de Leva 1996, Table 4 (male) and the segments' lengths on 1741 mm: (mass %, length mm,

@@ -31,7 +31,7 @@ from drake_standup.robot.icub import ContactModel, add_icub
 from drake_standup.sim.diagram import build_diagram
 from drake_standup.sim.simulate import simulate
 from drake_standup.world import perturbations
-from drake_standup.world.human import HumanWrenchSource
+from drake_standup.helper.hands import HumanWrenchSource
 from drake_standup.world.perturbations import (
     NoisyWrenchSensor,
     PushSource,

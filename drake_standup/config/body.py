@@ -1,4 +1,4 @@
-"""human.body: the helper as a body (human.mode: body, world/helper_body.py).
+"""human.body: the helper as a body (human.mode: body, helper/body.py).
 
 The person's intent is human.reactive's (the guide, its pace, its force, its reaction
 time); this section says who they are and how they hold the robot's hands.
@@ -13,13 +13,13 @@ TONES = ("soft", "stiff")
 @dataclass
 class BodyHelperConfig:
     # The person's stature and mass: any adult within the anthropometric table's reach
-    # (de Leva 1996, male; world/person.py). m, kg.
+    # (de Leva 1996, male; helper/anthropometry.py). m, kg.
     height_m: float = 1.75
     mass_kg: float = 75.0
     # soft (the default): a relaxed arm (Shadmehr & Mussa-Ivaldi 1994), the trunk at
     # 20 % effort (Gardner-Morse & Stokes 2001); stiff: the arms co-contracted, 3 times
     # stiffer, the trunk at 40 % effort; also how soon they give way (world/
-    # helper_body.py, JOINT_IMPEDANCE, YIELD_TIME_S). A stiff person reaches their back's
+    # helper/body.py, JOINT_IMPEDANCE, YIELD_TIME_S). A stiff person reaches their back's
     # strength and pulls up to 170 N at moments (docs/design.md).
     tone: str = "soft"
     # Hand in hand, the grip's translational spring and damper (a force element between

@@ -71,9 +71,9 @@ class ReactiveHumanConfig:
     is up (ease_com_rise_m).
     guide: velocity (the default): a person moving each hand along the direction
     of target_velocity_mps at its speed, for at most travel_m, from wherever they
-    saw the hand, keeping lead_min_m ahead of a hand that outruns them (human.py,
+    saw the hand, keeping lead_min_m ahead of a hand that outruns them (helper/hands.py,
     reactive_force): F = sat(K (p_target - p_hand) + D (v_target - v_hand), force_cap_N).
-    guide: path (human.py, path_force): a person walking each hand along a path
+    guide: path (helper/hands.py, path_force): a person walking each hand along a path
     in the sagittal plane (path_xz_m from where the hand was) at pace_mps, never
     more than lead_max_m ahead of the hand, never less than lead_min_m while the
     path goes on; the pull acts along the path only (never backwards, never
@@ -130,7 +130,7 @@ class ReactiveHumanConfig:
 @dataclass
 class HumanConfig:
     # scripted: the pulls below; reactive: the impedance helper (reactive:); body: a
-    # person's body pulling with reactive:'s intent (body:, world/helper_body.py).
+    # person's body pulling with reactive:'s intent (body:, helper/body.py).
     mode: str = "scripted"
     # Empty list: nobody helps.
     pulls: list[Pull] = field(default_factory=list)

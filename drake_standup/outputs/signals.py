@@ -17,8 +17,8 @@ from drake_standup.control.contacts import CONTACTS
 from drake_standup.control.controller import DIAGNOSTICS
 from drake_standup.ports.payloads import COM_REFERENCE, SEGMENT
 from drake_standup.robot.limbs import joint_group, shoulder_tendon_margin_rad
-from drake_standup.world.helper_body import state_order
-from drake_standup.world.human import HELPER_SPENT
+from drake_standup.helper.body import state_order
+from drake_standup.helper.work import HELPER_SPENT
 
 # Version of signals.npz's layout; bump it (and keep load_signals reading the
 # old ones) when an array changes meaning or shape.
@@ -117,7 +117,7 @@ def _station_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarr
         signals["pull_cop_shift_m"] = logs["pull_cop_shift_m"][:, 0]
     if "hand_velocities_W" in logs:  # [v_left, v_right] where the hands are pulled
         signals["hand_velocities_W"] = logs["hand_velocities_W"]
-    if "helper_spent" in logs:  # human.HelperWork's running totals, on the plant's steps
+    if "helper_spent" in logs:  # helper.work.HelperWork's running totals, on the plant's steps
         for k, name in enumerate(HELPER_SPENT):
             signals[name] = logs["helper_spent"][:, k]
     if "helper_torques_Nm" in logs:  # the helper's body (human.mode: body)
@@ -126,7 +126,7 @@ def _station_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarr
 
 
 def _helper_body_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """The person's joints (helper_body.py), each in their joint_names' order: angles,
+    """The person's joints (helper/body.py), each in their joint_names' order: angles,
     rates and the torques their muscles applied; their grips' wrenches and their intent."""
     helper = station.scene.helper
     order = state_order(station.plant, helper)

@@ -21,8 +21,9 @@ from drake_standup.robot.icub import actuated_joints
 from drake_standup.sim.visuals import StandupVisuals
 from drake_standup.standup.plan import StandupPlan, feet_reach, make_plan
 from drake_standup.standup.standup_controller import StandupController, make_standup_controller
-from drake_standup.world.helper_control import make_body_helper
-from drake_standup.world.human import HelperWork, HumanWrenchSource
+from drake_standup.helper.body_control import make_body_helper
+from drake_standup.helper.hands import HumanWrenchSource
+from drake_standup.helper.work import HelperWork
 from drake_standup.world.scene import Scene, set_seated_state
 from drake_standup.world.station import Station, make_station
 
@@ -150,7 +151,7 @@ def _add_station_and_human(
     builder.Connect(
         human.GetOutputPort("hand_wrenches_W"), world.GetInputPort("applied_hand_wrenches_W")
     )
-    # What the helper spends, on the plant's own steps (human.HelperWork).
+    # What the helper spends, on the plant's own steps (helper.work.HelperWork).
     spent = builder.AddNamedSystem("helper_work", HelperWork(scenario.plant.time_step))
     builder.Connect(world.GetOutputPort("hand_positions_W"), spent.GetInputPort("hand_positions_W"))
     builder.Connect(human.GetOutputPort("hand_wrenches_W"), spent.GetInputPort("hand_wrenches_W"))

@@ -1,2 +1,3 @@
-"""The simulated world: the scene (chair, floor), the station (plant, pad forces,
-sensing, perturbations) and the human's wrench on the hands."""
+"""The simulated world: the scene (chair, floor, where the robot and a person's body sit),
+the seating, the station (plant, pad forces, sensing, perturbations). The helper who
+pulls the hands is a layer of its own, below (drake_standup/helper/)."""

@@ -20,7 +20,7 @@ from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
 from drake_standup.world.chair import chair_sdf
-from drake_standup.world.helper_body import GRIPS, HelperBody, add_helper_body
+from drake_standup.helper.body import GRIPS, HelperBody, add_helper_body
 from drake_standup.world.perturbations import scale_friction
 from drake_standup.world.seating import SeatedPose, seated_pose
 
@@ -43,7 +43,7 @@ class Scene:
     robot: Robot
     # The robot on its chair at t = 0 (world/seating.py).
     seated: SeatedPose
-    # The helper's body (human.mode: body, world/helper_body.py), or None.
+    # The helper's body (human.mode: body, helper/body.py), or None.
     helper: HelperBody | None = None
     # With a helper's body: the same scene without it (the robot's own model, for the
     # controller: it needs every other model welded), else None.

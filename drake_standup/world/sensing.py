@@ -18,7 +18,7 @@ from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.balance import static_lean
 from drake_standup.robot.icub import Robot
 from drake_standup.robot.spatial import cross
-from drake_standup.world.human import TASK_FRAMES
+from drake_standup.helper.hands import TASK_FRAMES
 
 
 def heel_points(robot: Robot) -> dict[str, np.ndarray]:
@@ -143,8 +143,8 @@ class RobotSensing(LeafSystem):
     of the heels" holds for both feet) and thigh_x_W (1, m: the mean x of the
     thigh pads' centres, where the seat's support ends; NaN without pads),
     hand_positions_W and hand_velocities_W (6 each, m and m/s: the left and the right
-    hand frame's origin, where a pull is applied, human.hand_forces; what the helper's
-    work is summed over, human.HelperWork), pull_cop_shift_m (1, m: pull_cop_shift_m of
+    hand frame's origin, where a pull is applied, helper.hands.hand_forces; what the helper's
+    work is summed over, helper.work.HelperWork), pull_cop_shift_m (1, m: pull_cop_shift_m of
     the measured pull at the posture now, on the ground under the heels) and, with a
     StandingSupport, standing_pull_usage (1: standing_pull_usage of the measured pull).
 

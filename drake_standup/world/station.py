@@ -8,7 +8,7 @@ RussTedrake/manipulation's MakeHardwareStation: a diagram with named exported po
 
 Inputs
     actuation                 (nu) joint torques, actuator order, N m
-    hand_spatial_forces       the hands' pull on the robot (abstract, human.py)
+    hand_spatial_forces       the hands' pull on the robot (abstract, helper/hands.py)
     applied_hand_wrenches_W   (12) the same pull as wrenches, what the hands' sensors read
     desired_state             (2 nu) only with pd_gains (the seat-hold benchmark)
 Outputs

@@ -22,7 +22,7 @@ suprasternale's height (170.7 mm above XYPH on 1741, de Leva), 0.1 of the statur
 each side, and the hips 0.0461 of it (Dumas, Cheze, Verriest 2007, "Adjustments to
 McConville et al. and Young et al. body segment inertial parameters", J. Biomech.
 40(3), as the HeiMan model uses them). human.mode: body puts this person into the
-plant (helper_body.py), kneeling: the shanks flat behind the knees.
+plant (helper/body.py), kneeling: the shanks flat behind the knees.
 """
 
 from __future__ import annotations

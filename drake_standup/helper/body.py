@@ -1,4 +1,4 @@
-"""The helper as a body in the plant (human.mode: body): a person (person.py) kneeling in
+"""The helper as a body in the plant (human.mode: body): a person (helper/anthropometry.py) kneeling in
 front of the robot, their joints driven by Drake's PD actuators within their strength,
 their hands holding the robot's through a compliant grip.
 
@@ -13,7 +13,7 @@ their hands holding the robot's through a compliant grip.
   no torque the person could not produce acts. One limit for both directions: the weaker.
 - Impedance (JOINT_IMPEDANCE): joint stiffness and damping, scaled with mass (stiffness
   grows with the torque a joint holds, Gomi & Osu 1998).
-- Grip (helper_control.Grips): a spring-damper between each of the person's grip frames
+- Grip (helper.body_control.Grips): a spring-damper between each of the person's grip frames
   and the robot's hand frame, force only (config/body.py); the person's right hand holds
   the robot's left hand (they face each other). Drake's LinearBushingRollPitchYaw is
   the same element but throws near a 90 deg pitch between its frames (its roll-pitch-yaw),
@@ -31,7 +31,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable, PdControllerGains
 
 from drake_standup.config.body import BodyHelperConfig
-from drake_standup.world.person import (
+from drake_standup.helper.anthropometry import (
     DE_LEVA_MALE,
     SHOULDER_ABOVE_XYPH,
     Person,
@@ -101,7 +101,7 @@ class HelperBody:
 
 
 def joint_kind(name: str) -> str:
-    """A person's joint name (person.py) without its side: the tables' keys."""
+    """A person's joint name (helper/anthropometry.py) without its side: the tables' keys."""
     return name.removeprefix("left_").removeprefix("right_")
 
 

@@ -1,5 +1,5 @@
 """The reactive partner: a person guiding each of the robot's hands, as forces from what
-they see of the robot (HumanWrenchSource, human.py, evaluates them):
+they see of the robot (HumanWrenchSource, helper/hands.py, evaluates them):
 - velocity guide (reactive_force): along a direction at a pace, from wherever they saw
   the hand; they follow a hand that outruns them, still pulling it (lead_min ahead).
 - path guide (path_force): along a path in the sagittal plane at a pace, between

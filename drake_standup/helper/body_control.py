@@ -1,11 +1,11 @@
-"""The helper body's systems (human.mode: body; the body itself: helper_body.py).
+"""The helper body's systems (human.mode: body; the body itself: helper/body.py).
 
-- intent: human.reactive's partner (human.py, HumanWrenchSource): the pull each hand is
+- intent: human.reactive's partner (helper/hands.py, HumanWrenchSource): the pull each hand is
   meant to get, decided on what the person saw reaction_time_s ago.
 - PersonController, the person's muscles. Feed-forward: their own weight held and the
   intended pull pushed through their arms, u_ff = -g(q) + sum_i J_i(q)^T f_i. Impedance:
   Drake's implicit joint PD toward a set-point that follows their posture with a time
-  constant T (helper_body.YIELD_TIME_S, how soon they give way; dq_d/dt = v_d =
+  constant T (helper.body.YIELD_TIME_S, how soon they give way; dq_d/dt = v_d =
   (q - q_d) / T): a spring in series with a damper K T, passive, so it cannot ring.
   Their arms go with the hands they hold: they feel those hands move YIELD_LATENCY_S
   late and predict the motion now (carried on at the acceleration felt); the arms'
@@ -17,7 +17,7 @@
   advances psi (docs/design.md).
   The trunk is not dragged along but moves on its own: its flexion's set-point is the
   bend it takes to hold hands as high as they started plus the robot's CoM rise as the
-  person saw it reaction_time_s ago, carried on at the rate seen (helper_body.bend_for):
+  person saw it reaction_time_s ago, carried on at the rate seen (helper.body.bend_for):
   they straighten, leaning back, as the robot comes up, at most at their own pace
   (TRUNK_RATE_RAD_PER_S). Feeling a pull beyond their
   intent's cap (YIELD_LATENCY_S ago) they give way, wholly from twice it: the set-point
@@ -34,7 +34,7 @@
   their own hands' felt acceleration (a negative mass: fell at once); arms going with
   the held hands with no regard to the trunk's motion (lifted the robot: 290-450 N
   sole spikes in 3 of 8 people).
-- Grips: the hands' spring-damper (helper_body.py), on the robot's hands and on the
+- Grips: the hands' spring-damper (helper/body.py), on the robot's hands and on the
   person's, what the robot's wrist sensors read.
 """
 
@@ -55,7 +55,7 @@ from pydrake.systems.framework import (
 from drake_standup.config import HumanConfig, ReactiveHumanConfig
 from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.icub import Robot
-from drake_standup.world.helper_body import (
+from drake_standup.helper.body import (
     GRIPS,
     YIELD_TIME_S,
     HelperBody,
@@ -65,7 +65,7 @@ from drake_standup.world.helper_body import (
     joint_names,
     person_model,
 )
-from drake_standup.world.human import PERCEPTION_PERIOD_S, HumanWrenchSource, applied_at
+from drake_standup.helper.hands import PERCEPTION_PERIOD_S, HumanWrenchSource, applied_at
 
 # What the person perceives each update: the robot's CoM height and rate, the larger of
 # the pulls they feel in their hands, and the velocities of the robot's hands they hold.
