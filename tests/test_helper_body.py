@@ -11,8 +11,6 @@ from pydrake.multibody.tree import JacobianWrtVariable
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
 from drake_standup.config.body import BodyHelperConfig
-from drake_standup.outputs.signals import make_signals
-from drake_standup.sim.runner import advance, prepare
 from drake_standup.helper.body import (
     JOINT_IMPEDANCE,
     grip_frames,
@@ -20,6 +18,8 @@ from drake_standup.helper.body import (
     person_model,
     strength_and_impedance,
 )
+from drake_standup.outputs.signals import make_signals
+from drake_standup.sim.runner import advance, prepare
 
 BODY = SCENARIO_DIR / "body.yaml"
 # The cited maxima, N m, of the people the studies measured (helper/body.py): shoulder

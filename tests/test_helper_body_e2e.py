@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
-from drake_standup.sim.simulate import simulate
 from drake_standup.helper.body_control import TRUNK_RATE_RAD_PER_S
+from drake_standup.sim.simulate import simulate
 
 pytestmark = pytest.mark.slow
 

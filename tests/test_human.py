@@ -21,9 +21,9 @@ from drake_standup.config import (
     load_scenario,
     parse_scenario,
 )
-from drake_standup.sim.diagram import build_diagram
 from drake_standup.helper.hands import HumanWrenchSource
 from drake_standup.helper.partner import Path, path_force, reactive_force, trapezoid
+from drake_standup.sim.diagram import build_diagram
 
 PULLS = [
     Pull(hand="left", start_s=1.0, duration_s=2.0, ramp_s=0.5, force_N=[20.0, 0.0, 10.0]),

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from drake_standup.config import SCENARIO_DIR, HumanConfig, Push, Scenario, load_scenario
+from drake_standup.helper.hands import HumanWrenchSource
 from drake_standup.sim.diagram import build_diagram
 from drake_standup.sim.live import (
     RESET,
@@ -29,7 +30,6 @@ from drake_standup.sim.live import (
     run_session,
 )
 from drake_standup.sim.runner import advance, prepare
-from drake_standup.helper.hands import HumanWrenchSource
 
 REPO = Path(__file__).resolve().parent.parent
 

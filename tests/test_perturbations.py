@@ -27,11 +27,11 @@ from pydrake.systems.primitives import ConstantValueSource, ConstantVectorSource
 from drake_standup.config import HumanConfig, Pull, Push, Scenario, ScenarioError
 from drake_standup.config.chair import SEATED_JOINTS
 from drake_standup.config.resources import model_file
+from drake_standup.helper.hands import HumanWrenchSource
 from drake_standup.robot.icub import ContactModel, add_icub
 from drake_standup.sim.diagram import build_diagram
 from drake_standup.sim.simulate import simulate
 from drake_standup.world import perturbations
-from drake_standup.helper.hands import HumanWrenchSource
 from drake_standup.world.perturbations import (
     NoisyWrenchSensor,
     PushSource,

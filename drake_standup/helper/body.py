@@ -1,5 +1,5 @@
-"""The helper as a body in the plant (human.mode: body): a person (helper/anthropometry.py) kneeling in
-front of the robot, their joints driven by Drake's PD actuators within their strength,
+"""The helper as a body in the plant (human.mode: body): a person (anthropometry.py)
+kneeling in front of the robot, their joints driven by Drake's PD actuators within their strength,
 their hands holding the robot's through a compliant grip.
 
 - Kneeling: the seated iCub's hands lie ~0.3 m above the floor, out of a standing

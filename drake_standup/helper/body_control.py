@@ -53,8 +53,6 @@ from pydrake.systems.framework import (
 )
 
 from drake_standup.config import HumanConfig, ReactiveHumanConfig
-from drake_standup.ports.caching import declare_cached
-from drake_standup.robot.icub import Robot
 from drake_standup.helper.body import (
     GRIPS,
     YIELD_TIME_S,
@@ -66,6 +64,8 @@ from drake_standup.helper.body import (
     person_model,
 )
 from drake_standup.helper.hands import PERCEPTION_PERIOD_S, HumanWrenchSource, applied_at
+from drake_standup.ports.caching import declare_cached
+from drake_standup.robot.icub import Robot
 
 # What the person perceives each update: the robot's CoM height and rate, the larger of
 # the pulls they feel in their hands, and the velocities of the robot's hands they hold.

@@ -10,7 +10,6 @@ The wrench acts at the origin of the hand task frame (the hand's DH frame).
 
 from __future__ import annotations
 
-
 import numpy as np
 from pydrake.common.value import Value
 from pydrake.multibody.math import SpatialForce
@@ -18,9 +17,9 @@ from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlan
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
 from drake_standup.config import HumanConfig, Pull
+from drake_standup.helper.partner import Path, path_force, reactive_force, trapezoid
 from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.icub import Robot
-from drake_standup.helper.partner import Path, path_force, reactive_force, trapezoid
 
 HANDS = {"left": 0, "right": 1}
 # What a reactive person perceives, every PERCEPTION_PERIOD_S: the hands' positions (6)

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from drake_standup.helper.work import HELPER_SPENT
 from drake_standup.outputs.signals import group_normal_forces
 from drake_standup.robot.limbs import JOINT_GROUPS, joint_group, shoulder_tendon_margin_rad
-from drake_standup.helper.work import HELPER_SPENT
 
 
 def seated_metrics(signals: dict[str, np.ndarray], weight_N: float, settle_s: float = 0.5) -> dict:

@@ -15,10 +15,10 @@ import numpy as np
 from drake_standup.config import RESPONSES
 from drake_standup.control.contacts import CONTACTS
 from drake_standup.control.controller import DIAGNOSTICS
-from drake_standup.ports.payloads import COM_REFERENCE, SEGMENT
-from drake_standup.robot.limbs import joint_group, shoulder_tendon_margin_rad
 from drake_standup.helper.body import state_order
 from drake_standup.helper.work import HELPER_SPENT
+from drake_standup.ports.payloads import COM_REFERENCE, SEGMENT
+from drake_standup.robot.limbs import joint_group, shoulder_tendon_margin_rad
 
 # Version of signals.npz's layout; bump it (and keep load_signals reading the
 # old ones) when an array changes meaning or shape.

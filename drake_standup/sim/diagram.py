@@ -17,13 +17,13 @@ from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, Ve
 
 from drake_standup.config import RESPONSES, Scenario, validate
 from drake_standup.control.controller import WholeBodyController
+from drake_standup.helper.body_control import make_body_helper
+from drake_standup.helper.hands import HumanWrenchSource
+from drake_standup.helper.work import HelperWork
 from drake_standup.robot.icub import actuated_joints
 from drake_standup.sim.visuals import StandupVisuals
 from drake_standup.standup.plan import StandupPlan, feet_reach, make_plan
 from drake_standup.standup.standup_controller import StandupController, make_standup_controller
-from drake_standup.helper.body_control import make_body_helper
-from drake_standup.helper.hands import HumanWrenchSource
-from drake_standup.helper.work import HelperWork
 from drake_standup.world.scene import Scene, set_seated_state
 from drake_standup.world.station import Station, make_station
 

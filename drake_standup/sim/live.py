@@ -44,11 +44,11 @@ from pydrake.systems.framework import (
 )
 
 from drake_standup.config import RESPONSES, HumanConfig, Scenario
+from drake_standup.helper.hands import hand_forces, spatial_forces
 from drake_standup.robot.icub import Robot
 from drake_standup.sim.diagram import on_step_grid
 from drake_standup.sim.run_folder import write_run
 from drake_standup.sim.runner import Run, RunResult, advance, collect, finished, prepare
-from drake_standup.helper.hands import hand_forces, spatial_forces
 
 # The page's controls, in the order they appear.
 HANDS = ("left", "right")

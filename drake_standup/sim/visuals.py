@@ -32,8 +32,8 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context, EventStatus, LeafSystem
 
-from drake_standup.robot.icub import Robot
 from drake_standup.helper.hands import TASK_FRAMES
+from drake_standup.robot.icub import Robot
 
 PREFIX = "/standup"
 # Arrow length per newton: the largest pull a slider allows (25 N, SPEC 3's

@@ -18,9 +18,9 @@ from drake_standup.config import Scenario, ScenarioError, chair_file
 from drake_standup.config.inputs import add_sdf
 from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
+from drake_standup.helper.body import GRIPS, HelperBody, add_helper_body
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
 from drake_standup.world.chair import chair_sdf
-from drake_standup.helper.body import GRIPS, HelperBody, add_helper_body
 from drake_standup.world.perturbations import scale_friction
 from drake_standup.world.seating import SeatedPose, seated_pose
 

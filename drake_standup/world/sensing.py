@@ -14,11 +14,11 @@ import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import BasicVector, Context, LeafSystem
 
+from drake_standup.helper.hands import TASK_FRAMES
 from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.balance import static_lean
 from drake_standup.robot.icub import Robot
 from drake_standup.robot.spatial import cross
-from drake_standup.helper.hands import TASK_FRAMES
 
 
 def heel_points(robot: Robot) -> dict[str, np.ndarray]:
