@@ -192,3 +192,7 @@ def scenarios_main(argv: list[str] | None = None, prog: str = "drake-standup sce
         for name, path in shipped(folder).items():
             print(f"  {name:<12} {description(path)}")
     return 0
+
+
+if __name__ == "__main__":  # python -m drake_standup.cli COMMAND, as python -m drake_standup
+    sys.exit(main())

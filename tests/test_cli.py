@@ -173,10 +173,12 @@ def test_no_command_lists_the_commands(capsys):
     assert all(f"  {name} " in stdout for name in COMMANDS)
 
 
-def test_python_m_drake_standup_is_the_same_command(capsys):
-    """`python -m drake_standup scenarios` in a fresh process vs the command run here."""
+@pytest.mark.parametrize("module", ["drake_standup", "drake_standup.cli"])
+def test_python_m_drake_standup_is_the_same_command(capsys, module):
+    """`python -m drake_standup scenarios` (and `-m drake_standup.cli`, which once ran
+    nothing) in a fresh process vs the command run here."""
     done = subprocess.run(
-        [sys.executable, "-m", "drake_standup", "scenarios"],
+        [sys.executable, "-m", module, "scenarios"],
         cwd=REPO,
         capture_output=True,
         text=True,
