@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from docs_check import undocumented_metrics
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
 from drake_standup.outputs.signals import load_signals
@@ -54,6 +55,11 @@ def test_unassisted_stands_up_with_psi_equal_to_time(unassisted):
     assert m["contact_normal_force_N"]["thighs"] < 1.0
     assert m["contact_normal_force_N"]["buttocks"] < 1.0
     assert m["max_abs_torque_Nm"] <= scenario.robot.effort_limit_Nm + 1e-9
+
+
+def test_every_metric_of_the_assisted_run_is_documented(assisted):
+    """docs/outputs.md names each metrics.json key of the default scenario's run."""
+    assert undocumented_metrics(assisted[1]) == []
 
 
 def test_assisted_stands_up_sooner(assisted, unassisted):
