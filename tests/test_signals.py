@@ -125,21 +125,51 @@ def test_a_recording_does_not_change_the_simulation():
         np.testing.assert_array_equal(recorded[name], plain[name], err_msg=name)
 
 
+@pytest.mark.slow
+def test_a_recording_does_not_change_the_default_run():
+    """The whole default run (15 s, the stand-up and the pull), recorded and not: every
+    logged signal bitwise the same. The contact forces' publishes at 0.1 s once landed
+    an ulp off the plant's step at 3.9 s and split psi's integrator step: the two runs
+    parted there by 1e-10."""
+    from drake_standup.config import SCENARIO_DIR, load_scenario
+    from drake_standup.sim.simulate import simulate
+
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
+    plain = simulate(scenario, None, record=False, progress=False).signals
+    recorded = simulate(scenario, None, record=True, progress=False).signals
+    assert plain["time_s"][-1] == pytest.approx(scenario.duration_s, abs=0.02)
+    for name in plain:
+        np.testing.assert_array_equal(recorded[name], plain[name], err_msg=name)
+
+
 @pytest.mark.parametrize(
     ("period", "step", "expected"),
     [
         (1 / 30, 0.004, 0.032),
         (0.04, 0.004, 0.04),
-        (0.1, 0.004, 0.1),
+        (0.1, 0.004, 0.096),  # 25 steps land off the grid (below); 24 on it
+        (0.1, 0.001, 0.096),
+        (0.04, 0.01, 0.04),
         (0.001, 0.004, 0.004),
     ],
 )
-def test_publish_periods_land_on_whole_plant_steps(period, step, expected):
-    from drake_standup.sim.diagram import on_step_grid
+def test_publish_periods_land_on_the_plant_steps_themselves(period, step, expected):
+    """Every event k of the period is the plant's step k n in floating point, as Drake
+    computes both (k * period, m * step), over the horizon."""
+    from drake_standup.sim.diagram import ON_GRID_HORIZON_S, on_step_grid
 
     result = on_step_grid(period, step)
     assert result == pytest.approx(expected, rel=1e-12)
-    assert abs(result / step - round(result / step)) < 1e-9
+    n = round(result / step)
+    assert result == step * n
+    k = np.arange(1, int(ON_GRID_HORIZON_S / result) + 1)
+    assert np.array_equal(k * result, (k * n) * step)
+
+
+def test_a_whole_number_of_steps_is_not_enough():
+    """Why on_step_grid checks the products: 25 steps of 4 ms, 39 times, is not the
+    plant's 975th step (one ulp apart)."""
+    assert 39 * (0.004 * 25) != 975 * 0.004
 
 
 def test_the_psi_equals_t_run_in_its_own_process_equals_one_run_here(monkeypatch, capsys):

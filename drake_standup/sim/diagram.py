@@ -269,12 +269,25 @@ def _add_visuals(
         builder.Connect(sources[port.get_name()], port)
 
 
+# How long a run's periodic events are checked to land on the plant's steps (s): past
+# any run's duration.
+ON_GRID_HORIZON_S = 3600.0
+
+
 def on_step_grid(period_s: float, step_s: float) -> float:
-    """period_s rounded to a whole number (>= 1) of plant steps (step_s > 0: a discrete
-    plant, config.validate). A publish between the plant's steps splits an integrator
-    step of psi, so a recording would change the simulation it records; a run's chunk
-    end a rounding error off an event time makes the integrator take a ~1e-17 s step."""
-    return step_s * max(1, round(period_s / step_s))
+    """period_s as a whole number n (>= 1) of plant steps, the nearest n whose event times
+    are the plant's own in floating point: Drake puts a periodic event k at k * period
+    and the plant's step m at m * step_s, and k * (n h) == (k n) h does not hold for
+    every n (n = 25 at h = 4 ms: 3.9 s is one ulp apart). An event between the plant's
+    steps, even by an ulp, splits an integrator step of psi, so a recording (its
+    publishes) or a run's chunk ends would change the simulation (step_s > 0: a discrete
+    plant, config.validate)."""
+    nearest = max(1, round(period_s / step_s))
+    for n in sorted(range(1, 2 * nearest + 1), key=lambda n: (abs(n - nearest), n)):
+        k = np.arange(1, int(ON_GRID_HORIZON_S / (n * step_s)) + 2)
+        if np.array_equal(k * (step_s * n), (k * n) * step_s):
+            return step_s * n
+    return step_s * nearest
 
 
 def add_seat_hold(builder, scene: Scene, scenario: Scenario, desired_state, actuation) -> None:
