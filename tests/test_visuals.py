@@ -100,3 +100,38 @@ def _recorded_paths(html: str) -> set[str]:
     for data in re.findall(r"data:application/octet-binary;base64,([A-Za-z0-9+/=]+)", html):
         walk(msgpack.unpackb(base64.b64decode(data), strict_map_key=False))
     return found
+
+
+def _angle_deg(eye: np.ndarray, target: np.ndarray, point: np.ndarray) -> float:
+    a, b = target - eye, point - eye
+    return float(np.degrees(np.arccos(a @ b / np.linalg.norm(a) / np.linalg.norm(b))))
+
+
+def test_the_camera_frames_the_robot_and_a_kneeling_person():
+    """With a person's body helping, the default camera sees both the robot's default
+    target and the person (each within 30 deg of its axis; Meshcat's field of view is
+    75 deg high) side by side: the person at most 0.15 m nearer the camera than the
+    robot, where the default view has them 0.3 m or more in front of it (it looked at
+    the robot through the person). Without a person, or where the scenario sets the
+    camera, the scenario's pose is kept."""
+    from drake_standup.config.scenario import VisualizationConfig
+    from drake_standup.sim.visuals import camera_pose
+
+    vis = VisualizationConfig()
+    robot = np.array(vis.target_xyz_m)
+    eye, target = camera_pose(vis, None)
+    assert eye.tolist() == vis.camera_xyz_m and target.tolist() == vis.target_xyz_m
+
+    def nearer(eye: np.ndarray, person: np.ndarray) -> float:
+        return float(np.linalg.norm(robot - eye) - np.linalg.norm(person - eye))
+
+    for x in (0.7, 0.9, 1.2):  # where a short, a tall and a far person kneel
+        person = np.array([x, 0.0, 0.55])  # their chest, kneeling
+        assert nearer(np.array(vis.camera_xyz_m), person) >= 0.3
+        eye, target = camera_pose(vis, RigidTransform([x, 0.0, 0.0]))
+        assert _angle_deg(eye, target, robot) < 30.0
+        assert _angle_deg(eye, target, person) < 30.0
+        assert nearer(eye, person) <= 0.15
+    vis.camera_xyz_m = [2.0, 0.0, 1.0]
+    eye, _ = camera_pose(vis, RigidTransform([0.9, 0.0, 0.0]))
+    assert eye.tolist() == [2.0, 0.0, 1.0]

@@ -341,7 +341,9 @@ class VisualizationConfig:
     # (measured), so both visualizer periods are rounded to whole plant steps
     # (diagram.py); 40 ms is a whole multiple of every step of the study. s.
     publish_period_s: float = 0.04
-    # Camera position and target that frame the robot on its chair. m.
+    # Camera position and target that frame the robot on its chair; with a person's body
+    # helping and both at these defaults, the camera frames the person too
+    # (sim/visuals.camera_pose). m.
     camera_xyz_m: list[float] = field(default_factory=lambda: [1.05, -1.0, 0.8])
     target_xyz_m: list[float] = field(default_factory=lambda: [0.15, 0.0, 0.42])
     show_contact_forces: bool = True

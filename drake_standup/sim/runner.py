@@ -26,6 +26,7 @@ from drake_standup.outputs.metrics import run_metrics
 from drake_standup.outputs.signals import make_signals
 from drake_standup.robot.icub import reflects_motor_inertia
 from drake_standup.sim.diagram import StandupDiagram, build_diagram
+from drake_standup.sim.visuals import camera_pose
 from drake_standup.world.perturbations import apply_model_errors
 from drake_standup.world.scene import set_seated_state
 
@@ -169,7 +170,8 @@ def prepare(
     simulator.set_monitor(fall)
     if meshcat is not None:
         vis = scenario.visualization
-        meshcat.SetCameraPose(np.array(vis.camera_xyz_m), np.array(vis.target_xyz_m))
+        helper = station.scene.helper
+        meshcat.SetCameraPose(*camera_pose(vis, None if helper is None else helper.X_WP))
         built.visualizer.StartRecording(set_transforms_while_recording=live_transforms)
     started_s = time.perf_counter()
     simulator.Initialize()

@@ -32,6 +32,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context, EventStatus, LeafSystem
 
+from drake_standup.config.scenario import VisualizationConfig
 from drake_standup.helper.hands import TASK_FRAMES
 from drake_standup.robot.icub import Robot
 
@@ -62,6 +63,27 @@ PSI_LEAD_M_PER_S = 0.25
 LAMP_RADIUS_M = 0.04
 # The CoM spheres' offset along world y (the robot's right): clear of the body. m.
 COM_SIDE_OFFSET_M = -0.3
+
+
+def camera_pose(vis: VisualizationConfig, helper_X_WP: RigidTransform | None = None):
+    """The recording's camera position and target (m, world): the scenario's. With a
+    person's body kneeling at helper_X_WP in front of the robot and both keys at their
+    defaults, the default camera would look at the robot through the person: it moves to
+    the robot's right side, nearly side-on, aimed at the middle between the robot's
+    target and the person, and back by the distance between them, so both are in view."""
+    default = VisualizationConfig()
+    xyz, target = np.array(vis.camera_xyz_m), np.array(vis.target_xyz_m)
+    if helper_X_WP is None or not (
+        vis.camera_xyz_m == default.camera_xyz_m and vis.target_xyz_m == default.target_xyz_m
+    ):
+        return xyz, target
+    person = helper_X_WP.translation()
+    gap = max(person[0] - target[0], 0.0)
+    middle = np.array([target[0] + 0.5 * gap, target[1], target[2]])
+    # Nearly side-on (the person leans over the robot's hands), at the default view's
+    # height over its target and a distance that grows with the gap.
+    distance = 0.75 * np.linalg.norm(xyz[:2] - target[:2]) + gap
+    return middle + np.array([0.1 * distance, -distance, xyz[2] - target[2]]), middle
 
 
 def arrow_pose(p_W: np.ndarray, f_W: np.ndarray) -> RigidTransform:
