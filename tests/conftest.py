@@ -1,4 +1,5 @@
-"""Shared fixtures: one seated run, simulated once per test session."""
+"""Shared fixtures: one seated run, simulated once per test session; the default scene
+seated, once per test module; a limp robot rig for the human sources."""
 
 from __future__ import annotations
 
@@ -16,6 +17,21 @@ def seated_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("seated")
     result = simulate(scenario, out, record=True, progress=False)
     return scenario, result, out
+
+
+@pytest.fixture(scope="module")
+def seated_scene():
+    """The default scenario's scene (world/scene.py, no diagram around it) and a plant
+    context in its seated pose; each test module gets its own (they move the context)."""
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_standup.config import Scenario
+    from drake_standup.world.scene import add_scene, set_seated_state
+
+    scene = add_scene(DiagramBuilder(), Scenario(), pd_gains=None, visuals=False)
+    context = scene.plant.CreateDefaultContext()
+    set_seated_state(scene, context)
+    return scene, context
 
 
 @pytest.fixture

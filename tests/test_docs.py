@@ -1,5 +1,5 @@
 """The docs name what a run writes: every metrics.json key of a run is in docs/outputs.md's
-metrics.json section (the assisted run's in tests/test_standup_e2e.py)."""
+metrics.json section (the assisted run's in tests/e2e/test_standup_e2e.py)."""
 
 from __future__ import annotations
 

@@ -63,7 +63,7 @@ PLANT_STEP = Range(
 # What the values at some key paths accept: a Range (of each entry of a list too), a length
 # n (a list of n entries), INTERVAL or a tuple of accepted strings. The key paths are
 # patterns separated by spaces, '*' standing for any part of a name and '[*]' for any list
-# index. Checked in this order (tests/test_config.py: every pattern names a key).
+# index. Checked in this order (tests/config/test_config.py: every pattern names a key).
 RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (("scripted", "reactive", "body"), "human.mode"),
     (TONES, "human.body.tone"),

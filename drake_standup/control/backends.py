@@ -32,7 +32,7 @@ class DaqpBackend:
     def __init__(self, size: int):
         self._sense = np.zeros(size, dtype=np.int32)
         # daqp's infeasible verdict is wrong on some programs that have a solution
-        # (tests/test_controller.py counts them on random states): Clarabel tries each
+        # (tests/control/test_controller.py counts them on random states): Clarabel tries each
         # program daqp fails, and only a solution meeting its rows is taken.
         self._fallback: dict[tuple[int, int], DrakeBackend] = {}
         self.fallbacks = 0  # programs daqp failed that Clarabel solved

@@ -12,7 +12,7 @@ F = kappa W delta^2 / (2 theta), so dF/d delta = sqrt(2 F kappa W / theta), and
 
     k(F, theta) = min(kappa L W, sqrt(2 F kappa W / theta))                        (1)
 
-(tests/test_pad_dynamics.py checks it against Drake's contact surfaces). At 0.1 degrees of
+(tests/control/test_pad_dynamics.py checks it against Drake's contact surfaces). At 0.1 degrees of
 tilt and a few newtons the pad is 50 times softer than flat: k is worked out each tick.
 
 Over the coming control period T the pad's normal force, from the F measured now and the

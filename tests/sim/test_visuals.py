@@ -9,6 +9,7 @@ import re
 import msgpack
 import numpy as np
 from pydrake.math import RigidTransform
+from test_live import _click, _Live, _quick, _set_pull
 
 from drake_standup.config import SCENARIO_DIR, load_scenario
 from drake_standup.sim.live import STAND_UP
@@ -20,7 +21,6 @@ from drake_standup.sim.visuals import (
     PSI_DOT_M,
     PULL_M_PER_N,
 )
-from tests.test_live import _click, _Live, _quick, _set_pull
 
 
 def _transform(meshcat, path: str) -> RigidTransform:

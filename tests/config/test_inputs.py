@@ -40,7 +40,7 @@ from drake_standup.config.inputs import check_chair_file, model_names, scene_fra
 from drake_standup.robot.icub import ContactModel, Robot, add_icub
 from drake_standup.world.perturbations import robot_body_names
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 SHIPPED_CHAIR = REPO / "models" / "chair.sdf"
 MODEL = "iCubGazeboV2_5"
 THIGHS = "l_upper_leg_back_contact, r_upper_leg_back_contact"
@@ -385,7 +385,7 @@ BAD = {
         "iCubGazeboV2_5 reduced: {bodies}",
     ),
     # A run count no sweep means, refused from the sizes before any run is expanded
-    # (tests/test_sweep.py times it); the total counts the grid's combinations too.
+    # (tests/studies/test_sweep.py times it); the total counts the grid's combinations too.
     "sweep_too_many_samples": (
         {"many.yaml": "base: assisted\nsamples: 100000000\n"},
         ["sweep", "many.yaml"],

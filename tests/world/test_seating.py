@@ -17,7 +17,7 @@ from drake_standup.world.chair import chair_sdf
 from drake_standup.world.scene import add_scene
 from drake_standup.world.seating import JOINT_MARGIN_RAD, PAD_SINK_M, seat_height_range
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 MODEL = "iCubGazeboV2_5"
 
 

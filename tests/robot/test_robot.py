@@ -35,7 +35,7 @@ from drake_standup.robot.icub import (
 )
 from drake_standup.world.scene import add_scene, set_seated_state
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 URDF = Path(icub_models.get_model_file(DEFAULT_MODEL))
 CONTACT_YAML = yaml.safe_load((REPO / "models" / "icub_contact.yaml").read_text())
 PAD_NAMES = [shape["name"] for shape in CONTACT_YAML["shapes"]]

@@ -12,9 +12,8 @@ from pydrake.common.eigen_geometry import AngleAxis
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.tree import JacobianWrtVariable
-from pydrake.systems.framework import DiagramBuilder
 
-from drake_standup.config import ControllerConfig, Scenario
+from drake_standup.config import ControllerConfig
 from drake_standup.control.model import HANDS, ControllerJoints, contact_specs
 from drake_standup.control.qp import ContactMap
 from drake_standup.control.targets import TaskReferences
@@ -30,18 +29,14 @@ from drake_standup.control.tasks import (
     next_posture_reference,
 )
 from drake_standup.control.terms import RobotKinematics
-from drake_standup.world.scene import add_scene, set_seated_state
 
 SEEDS = range(3)
 
 
 @pytest.fixture(scope="module")
-def rig():
-    scenario = Scenario()
-    scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
+def rig(seated_scene):
+    scene, context = seated_scene
     plant, robot = scene.plant, scene.robot
-    context = plant.CreateDefaultContext()
-    set_seated_state(scene, context)
     specs = contact_specs(plant, robot, ControllerConfig())
     kinematics = RobotKinematics(
         plant, robot, held_frames=[], other_frames=[s.frame for s in specs] + list(HANDS)

@@ -11,7 +11,6 @@ from functools import partial
 
 import numpy as np
 import pytest
-from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import ControllerConfig, Scenario
 from drake_standup.config.inputs import TASK_FRAMES
@@ -27,7 +26,6 @@ from drake_standup.standup.task_references import (
     PhaseReferences,
     ReferenceGenerator,
 )
-from drake_standup.world.scene import add_scene, set_seated_state
 from drake_standup.world.sensing import StandingSupport, standing_lean, standing_pull_usage
 
 T = 0.004
@@ -36,12 +34,9 @@ TABLE = PhaseTable()
 
 
 @pytest.fixture(scope="module")
-def rig():
-    scenario = Scenario()
-    scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
+def rig(seated_scene):
+    scene, context = seated_scene
     plant, robot = scene.plant, scene.robot
-    context = plant.CreateDefaultContext()
-    set_seated_state(scene, context)
     instance = robot.model_instance
     rng = np.random.default_rng(4)
     plant.SetVelocities(context, instance, rng.normal(scale=0.2, size=plant.num_velocities()))

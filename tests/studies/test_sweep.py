@@ -269,7 +269,7 @@ def test_a_run_count_no_sweep_means_is_refused_at_once(tmp_path, text, field):
     line naming the field, within seconds: refused from the sizes, before expansion (which
     would outlast the timeout, or the memory)."""
     path = _write(tmp_path, text)
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent)}
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
     t0 = time.perf_counter()
     done = subprocess.run(
         [sys.executable, "-m", "drake_standup", "sweep", str(path), "--out", str(tmp_path / "o")],

@@ -31,7 +31,7 @@ from drake_standup.sim.live import (
 )
 from drake_standup.sim.runner import advance, prepare
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 
 
 def _click(meshcat, button: str) -> None:

@@ -24,7 +24,7 @@ from drake_standup.config import (
     parse_scenario,
 )
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 SEATED = REPO / "scenarios" / "seated.yaml"
 
 
@@ -182,7 +182,7 @@ def test_controller_period_on_the_plant_grid_is_accepted(tmp_path, time_step, pe
 def test_the_documented_scenario_examples_parse(document, section):
     """The README's keys and docs/outputs.md's full list are valid scenarios (keeps both
     true)."""
-    text = (Path(__file__).resolve().parents[1] / document).read_text()
+    text = (Path(__file__).resolve().parents[2] / document).read_text()
     example = text[text.index(section) :].split("```yaml\n", 1)[1].split("```", 1)[0]
     scenario = parse_scenario(example)
     assert scenario.phases.rise.com_height_erect and scenario.phases.rise.com_height_m is None
