@@ -1,11 +1,110 @@
-"""The docs name what a run writes: every metrics.json key of a run is in docs/outputs.md's
-metrics.json section (the assisted run's in tests/e2e/test_standup_e2e.py)."""
+"""The docs are true to the code, and kept so: every link, file, module name and cited
+section a doc or a docstring names exists, every commit a doc names is in the history,
+and every metrics.json key of a run is in docs/outputs.md (the default scenario's run in
+tests/e2e/test_standup_e2e.py). Each check is also shown to fail on a broken name."""
 
 from __future__ import annotations
 
 import json
+import shutil
+from pathlib import Path
 
-from docs_check import metrics_section, undocumented_metrics
+import docs_check
+import pytest
+from docs_check import (
+    DOCUMENTS,
+    PACKAGE,
+    REPO,
+    broken_links,
+    metrics_section,
+    missing_commits,
+    missing_names,
+    missing_paths,
+    missing_sections,
+    named_commits,
+    undocumented_metrics,
+)
+
+# Sources whose docstrings and comments name files and sections.
+SOURCES = [
+    *sorted(PACKAGE.rglob("*.py")),
+    *sorted((REPO / "tests").rglob("*.py")),
+    *sorted((REPO / "scenarios").glob("*.yaml")),
+    *sorted((REPO / "sweeps").glob("*.yaml")),
+    REPO / "run_diagram.py",
+    REPO / "pyproject.toml",
+]
+SOURCES = [p for p in SOURCES if p.name != "docs_check.py"]  # its own examples
+
+
+def _ids(paths: list[Path]) -> list[str]:
+    return [str(p.relative_to(REPO)) for p in paths]
+
+
+@pytest.mark.parametrize("doc", DOCUMENTS, ids=_ids(DOCUMENTS))
+def test_every_link_of_a_doc_leads_to_a_file_and_heading(doc):
+    assert broken_links(doc) == []
+
+
+@pytest.mark.parametrize("doc", DOCUMENTS, ids=_ids(DOCUMENTS))
+def test_every_file_and_module_name_a_doc_names_exists(doc):
+    assert missing_paths(doc) == []
+    # The changelog names the old places on purpose.
+    assert missing_names(doc, backticked_only=True, qualified=doc.name != "CHANGELOG.md") == []
+
+
+@pytest.mark.parametrize("source", SOURCES, ids=_ids(SOURCES))
+def test_every_file_a_docstring_or_comment_names_exists(source):
+    assert missing_paths(source) == []
+    assert missing_names(source, qualified=False) == []
+
+
+@pytest.mark.parametrize("path", DOCUMENTS + SOURCES, ids=_ids(DOCUMENTS + SOURCES))
+def test_every_section_cited_by_its_heading_exists(path):
+    assert missing_sections(path) == []
+
+
+@pytest.mark.skipif(
+    shutil.which("git") is None or not (REPO / ".git").exists(), reason="not a git checkout"
+)
+def test_every_commit_a_doc_names_is_in_the_history():
+    named = set().union(*(named_commits(doc.read_text()) for doc in DOCUMENTS))
+    assert len(named) >= 10  # the docs do cite commits: the check has something to check
+    assert missing_commits(named) == []
+
+
+def test_the_checks_find_a_name_broken_on_purpose(tmp_path):
+    """Each check above, on a copy of a true text with one name broken."""
+    design = REPO / "docs" / "design.md"
+    doc = REPO / "docs" / "broken.md"  # never written: the checks take the text
+    assert broken_links(doc, "[the layout](design.md#layout)") == []
+    assert broken_links(doc, "[the layout](design.md#no-such-heading)") == [
+        "design.md#no-such-heading"
+    ]
+    assert broken_links(doc, "[gone](no_such_file.md)") == ["no_such_file.md"]
+    assert missing_paths(doc, "see drake_standup/sim/diagram.py") == []
+    assert missing_paths(doc, "see drake_standup/sim/diagrams.py") == [
+        "drake_standup/sim/diagrams.py"
+    ]
+    assert missing_names(doc, "`diagram.on_step_grid`", backticked_only=True) == []
+    assert missing_names(doc, "`diagram.on_step_grids`", backticked_only=True) == [
+        "diagram.on_step_grids"
+    ]
+    assert missing_names(doc, "`references.static_lean`", backticked_only=True) == [
+        "references.static_lean"
+    ]
+    assert missing_names(doc, "`drake_standup.sim.diagram.nothing`", backticked_only=True)
+    assert missing_names(doc, "(see reference.py)", qualified=False) == ["reference.py"]
+    assert missing_sections(design, 'docs/design.md, "Layout"') == []
+    assert missing_sections(design, 'docs/design.md, "The house"') == [
+        'docs/design.md, "The house"'
+    ]
+    if (REPO / ".git").exists():
+        assert missing_commits({"0000000abc"}) == ["0000000abc"]
+    assert named_commits("at 745f4cd, not 1234567 nor abcdefa") == {"745f4cd"}
+    assert docs_check.slug("Issue 46, fifth part: the soles' last slaps") == (
+        "issue-46-fifth-part-the-soles-last-slaps"
+    )
 
 
 def test_every_metric_of_the_seated_run_is_documented(seated_run):

@@ -113,7 +113,7 @@ def test_the_check_sees_every_kind_of_import(tmp_path, monkeypatch):
 
 
 # The package's layers, lowest first: a module imports only from its own layer or lower
-# ones (docs/design.md, "The house"). The top-level modules (cli, __main__) sit above all.
+# ones (docs/design.md, "Layout"). The top-level modules (cli, __main__) sit above all.
 LAYERS = (
     "ports",
     "config",

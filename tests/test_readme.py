@@ -16,7 +16,7 @@ def _table() -> list[str]:
 
 
 def _named(cell: str) -> list[tuple[str, list[str]]]:
-    """(file, names) for each `dir/file.py` in cell and the `names` after it (up to the next
+    """(file, names) for each `DIR/FILE.py` in cell and the `names` after it (up to the next
     file)."""
     found, current = [], None
     for token in re.findall(r"`([^`]+)`", cell):

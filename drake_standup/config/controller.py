@@ -96,7 +96,7 @@ class ControllerConfig:
     torsional_friction_coefficient_m: float = 1.0 / 75.0
     # A held contact's rows ask J vdot + Jdot v = -k J v: a foot that has begun to slip
     # (a pull the pads' friction barely holds) is braked back to rest instead of being
-    # left to drift (docs/design.md, "Held contacts brake their slip"). 1/s.
+    # left to drift (docs/design.md, "Leaving the seat"). 1/s.
     contact_velocity_gain_per_s: float = 20.0
     # Minimum normal force of a seated pad and of each sole (SPEC 3). N.
     min_normal_force_N: float = 10.0

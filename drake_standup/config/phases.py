@@ -137,7 +137,7 @@ class Phase:
     unload_s: float = 0.0
     # The release begins once the CoM is at least this far in front of the thigh pads'
     # centres (the seat's support line: released behind it, the robot tips back onto
-    # the chair, docs/design.md "Leaving the seat for its reason"); None: at entry. m.
+    # the chair, docs/design.md, "Leaving the seat"); None: at entry. m.
     unload_when: float | None = None
     # The CoM target leans against the hands' pull (the feet alone carry the robot).
     lean: bool = False

@@ -243,7 +243,7 @@ class StandupConfig:
     # hold (sensing.standing_pull_usage: its lean plus the soles' CoP boxes) is answered
     # as a hindering pull is: the stand-up waits, or sits back, until it eases. 20 N
     # forward and up per hand (0.52) stands up at every psi_dot bound; 25 N (0.68) stood
-    # up and fell at two of four (docs/design.md, "A pull the feet cannot take"). -.
+    # up and fell at two of four (docs/design.md, "Hindering pulls"). -.
     standing_pull_usage_limit: float = 0.6
     # Such a pull first braces the arms: they hold the posture they sat with instead of
     # reaching out, which brings the hands lower and nearer the feet and shortens the
@@ -255,7 +255,7 @@ class StandupConfig:
     resume_after_s: float = 0.5
     # A step back (when_hindered) sits the robot back into state 1 while the pads its
     # phase releases still carry more than this fraction of their load, and goes back
-    # one phase while they unload (docs/design.md, "A pull against the stand-up").
+    # one phase while they unload (docs/design.md, "Hindering pulls").
     reseat_above_thigh_load: float = 0.9
     # The force guards read forces low-pass filtered with this time constant: the pads'
     # contact forces ring at 20-50 Hz. s.

@@ -26,8 +26,9 @@ class ContactSpec:
     torsional_friction_coefficient: float  # mu_t: |tau_z| <= mu_t f_z, m
     cop_x_m: tuple[float, float] = (0.0, 0.0)  # CoP box along C's x: (min, max)
     cop_y_m: tuple[float, float] = (0.0, 0.0)  # CoP box along C's y: (min, max)
-    # True: a force at Co only (unknowns f_C; friction pyramid, no CoP box): the thighs,
-    # whose CoP does not matter to the task and whose moments would cost QP size.
+    # True: a force at Co only (unknowns f_C; friction pyramid, no CoP box), for a contact
+    # whose CoP does not matter to the task (none of CONTACTS since the thighs became
+    # 6-D in issue 21).
     point: bool = False
     # True: the QP may hold the contact's body still at hold_point_m (the rows of C that
     # the contact command picks). False: a wrench only, for a contact that the held ones

@@ -11,7 +11,7 @@ The controller's model (control/model.py) scales every body's mass by its own sc
 which follows the estimate only once they differ by more than RESCALE_ABOVE: rescaling
 the model costs 83 us, against a ~600 us tick (docs/performance.md). Frozen from the
 first stand-up on: a robot sat back by a hindering pull rocks on the seat, and weighing
-it then put the model off (docs/design.md, "The robot weighs itself").
+it then put the model off (docs/design.md, "Weighing itself while seated").
 """
 
 from __future__ import annotations

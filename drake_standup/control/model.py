@@ -32,8 +32,8 @@ def contact_specs(
     plant: MultibodyPlant, robot: Robot, config: ControllerConfig, chair=None
 ) -> list[ContactSpec]:
     """The controller's contacts (CONTACTS): the seat, held at the hip axis (the mid-point
-    of controller.seat_hinge_joints' frames), both thighs (point forces, pinned by the
-    others), both soles; friction and CoP boxes from the config; with
+    of controller.seat_hinge_joints' frames), both thighs (6-D, a CoP box on
+    each pad), both soles; friction and CoP boxes from the config; with
     controller.seat_pad_dynamics, the thighs' pads' compliance on chair's seat
     (ChairConfig; None: a rigid seat)."""
     seat = robot.frame(plant, "seat")

@@ -1,8 +1,8 @@
 """The contact schedule: from the stand-up mode, what the QP may ask of each contact.
 
 The controller's contacts (CONTACTS): the seat (a 6-D contact on root_link under the
-buttocks, held at the hip axis), both thighs (point forces, pinned by the others) and
-both soles (6-D). The phase table (phases.py) says when each seat pad's load is released
+buttocks, held at the hip axis), both thighs (6-D, their CoP on their pads) and both
+soles (6-D). The phase table (phases.py) says when each seat pad's load is released
 (transitions.seat_loads: what is left of it, NaN while seated). From that:
 
     chair contacts in the QP   while any seat pad is seated or still carries load
@@ -22,7 +22,7 @@ memory: a pad lifting off cannot push). The measured bound: the thighs are force
 does not pin, and it planned on up to three times what the compliant pads carried; a
 seated pad too (on a 0.18 m seat the thighs slope up off it: the plan leaned 50-58 N on
 each while they carried none, and the robot dropped onto its feet, 209 N of chatter). Why
-the seat holds no rows once the buttocks release: docs/design.md, "Contacts".
+the seat holds no rows once the buttocks release: docs/design.md, "Leaving the seat".
 """
 
 from __future__ import annotations

@@ -212,7 +212,7 @@ def _sit_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupM
     and returns to where the CoM sat at the start, over phases.seated.segment_psi; state
     1's balancing time runs again from now, and its exit waits for the return. Held where
     it was instead, each later forward segment ended its offset further on and the
-    robot stood up past its toes (docs/design.md, "A pull against the stand-up"). "Where
+    robot stood up past its toes (docs/design.md, "Hindering pulls"). "Where
     the reference is" is the one used: its height the CoM's where the segment followed
     it; the return holds its own height (height_follows off)."""
     x_now = mode.reference(m.psi, m.com_W)
@@ -237,7 +237,7 @@ def _step_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> Standup
     (they carry what the chair gives) and the reference stops where it is (psi = t,
     nothing advances). Once the pull has stopped, the previous phase's guard (calm among
     them) enters this phase again, whose segment then ends where the interrupted one
-    would have (docs/design.md, "A pull against the stand-up"). The hold keeps the height
+    would have (docs/design.md, "Hindering pulls"). The hold keeps the height
     of the reference used when it began (height_follows off)."""
     x_now = mode.reference(m.psi, m.com_W)
     entry = list(mode.entry_times_s)

@@ -1,6 +1,6 @@
 """Many independent simulations on a Dask cluster: a LocalCluster of single-threaded
 worker processes on this machine, or the scheduler at an address. Used by the sweeps
-(sweep.py) and the convergence study (convergence.py)."""
+(sweep.py) and the convergence study (convergence/)."""
 
 from __future__ import annotations
 

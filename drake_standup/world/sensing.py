@@ -73,7 +73,7 @@ def standing_lean(
     """What a pull asks of the standing robot's feet, judged on the robot standing
     (whatever its posture now): the hands' wrenches (payloads.HAND_WRENCHES) at its
     standing hands give a resultant about the CoM that needs the static lean d (3,) of
-    references.static_lean at the erect height; and how far the feet can shift the CoM
+    balance.static_lean at the erect height; and how far the feet can shift the CoM
     against it (3: forward, back, sideways), leaning up to lean_m and moving the CoP to
     the edge of the soles' boxes (half their length forward and back, half the span of
     both boxes sideways). None if the pull lifts the robot."""

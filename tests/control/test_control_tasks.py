@@ -1,4 +1,4 @@
-"""The QP consumes task objects generically (drake_standup/control/qp.py, tasks.py).
+"""The QP consumes task objects generically (drake_standup/control/qp.py, control/tasks/).
 
 A task written here, outside the package, is handed to WholeBodyQp like the controller's
 own: where it is active the solution meets it, where it is not the solution is the one

@@ -1,4 +1,4 @@
-"""The contact schedule (control/schedule.py): the bounds, the unloading memory and the
+"""The contact schedule (standup/contact_schedule.py): the bounds, the unloading memory and the
 seat's hold, from hand-computed cases; and the system's memory over ticks."""
 
 from __future__ import annotations

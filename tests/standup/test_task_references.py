@@ -1,4 +1,4 @@
-"""The task references (control/references.py) from the phase table, against values
+"""The task references (standup/task_references.py) from the phase table, against values
 computed here from Drake's CoM, momentum and joint limits: gains, posture targets, the
 centroidal momentum target, the help let through, the stance, the lean, the base target,
 and the generator's memory over ticks."""
