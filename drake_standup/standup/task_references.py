@@ -32,6 +32,7 @@ acts: advancement lets f_par through; stiff and compliant compensate the whole p
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -45,6 +46,43 @@ from drake_standup.standup.com_path import CoMTarget
 
 # The response codes (the index in config.RESPONSES) the controller's systems read.
 ADVANCEMENT, STIFF, COMPLIANT = (RESPONSES.index(name) for name in RESPONSES)
+
+
+@dataclass(frozen=True)
+class TickInputs:
+    """What one tick of the references reads now (standup/whole_body.py gives them)."""
+
+    standup_state: int
+    com_reference: np.ndarray  # [x_d, xd_dot, xd_ddot] (9,), world
+    # [tau_l, f_l, tau_r, f_r] (12,), world; None: no pull
+    F_hand_W: np.ndarray | None = None
+    path_progress: float = 1.0  # how far along its segment the CoM reference is, 0-1
+    response: int = ADVANCEMENT  # ADVANCEMENT, STIFF or COMPLIANT (module docstring)
+    psi_dot: float = 1.0  # the advancement's rate (the posture filter's clock)
+    braced: bool = False  # the arms braced against a strong pull (PhaseReferences)
+
+
+@dataclass(frozen=True)
+class CarriedState:
+    """What the references carry from one tick to the next (the whole-body system's
+    discrete state); CarriedState.after(references) is the next tick's."""
+
+    momentum_integral: np.ndarray  # int L_ang dt (3,)
+    posture: np.ndarray  # the posture filter's state (TaskReferences.next_posture)
+    lean_W: np.ndarray | None = None  # the lean's filtered value (None: zero)
+    height_integral: float = 0.0  # the stance's integral of the CoM height error, m s
+    compliance: np.ndarray | None = None  # the admittance's [offset, rate] (None: at rest)
+
+    @staticmethod
+    def after(references: TaskReferences) -> "CarriedState":
+        """What a tick's references leave to the next tick."""
+        return CarriedState(
+            momentum_integral=references.next_momentum_integral,
+            posture=references.next_posture,
+            lean_W=references.lean_W,
+            height_integral=references.next_height_integral,
+            compliance=references.next_compliance,
+        )
 
 
 class PhaseReferences:
@@ -171,57 +209,37 @@ class ReferenceGenerator:
         next_posture = np.concatenate((self._latched, q_initial, q_next, q_stage_next, (base_yaw,)))
         return q_reference, next_posture, base_yaw
 
-    def calc(
-        self,
-        terms: RobotTerms,
-        standup_state: int,
-        com_reference: np.ndarray,
-        F_hand_W: np.ndarray | None,
-        momentum_integral: np.ndarray,
-        posture: np.ndarray,
-        lean_W: np.ndarray | None = None,
-        path_progress: float = 1.0,
-        height_integral: float = 0.0,
-        response: int = ADVANCEMENT,
-        compliance: np.ndarray | None = None,
-        psi_dot: float = 1.0,
-        braced: bool = False,
-    ) -> TaskReferences:
-        """com_reference = [x_d, xd_dot, xd_ddot] (9,); F_hand_W = [tau_l, f_l, tau_r, f_r]
-        (None: no pull); momentum_integral = int L_ang dt; posture: the posture state
-        before this tick (TaskReferences.next_posture); lean_W: the lean's filtered value
-        before this tick (None: zero); path_progress: how far along its segment the CoM
-        reference is, 0-1; height_integral: the stance's integral of the CoM height
-        error before this tick, m s; response: ADVANCEMENT, STIFF or COMPLIANT (which of
-        the pull acts, module docstring); compliance: the admittance's [offset, rate]
-        before this tick (None: at rest); psi_dot: the advancement's rate (the posture
-        filter's clock); braced: the arms braced against a strong pull (PhaseReferences)."""
-        state = self.schedule[standup_state, braced]
+    def calc(self, terms: RobotTerms, now: TickInputs, carried: CarriedState) -> TaskReferences:
+        """This tick's references from the robot's terms, what the tick reads now and what
+        the last tick left."""
+        standup_state, F_hand_W, response = now.standup_state, now.F_hand_W, now.response
+        psi_dot, compliance = now.psi_dot, carried.compliance
+        state = self.schedule[standup_state, now.braced]
         tau_hand = None if F_hand_W is None else terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
         com_target, lean, next_compliance = self.com_target.target(
             terms,
             state,
-            com_reference,
+            now.com_reference,
             tau_hand,
             F_hand_W,
-            lean_W,
+            carried.lean_W,
             np.zeros(6) if compliance is None else compliance,
             response == COMPLIANT,
             psi_dot,
         )
-        stance, vertical_weight_scale = self._stance(state, path_progress)
+        stance, vertical_weight_scale = self._stance(state, now.path_progress)
         helped = F_hand_W is not None and response == ADVANCEMENT
         momentum = self.momentum.target(
             terms,
             com_target,
             state.com_kp_per_s2,
             state.com_kd_per_s,
-            momentum_integral,
+            carried.momentum_integral,
             stance,
-            height_integral,
+            carried.height_integral,
             F_hand_W[3:6] + F_hand_W[9:12] if helped else None,
         )
-        q_reference, next_posture, base_yaw = self._posture(terms, state, posture, psi_dot)
+        q_reference, next_posture, base_yaw = self._posture(terms, state, carried.posture, psi_dot)
         return TaskReferences(
             standup_state=standup_state,
             state=state,

@@ -40,7 +40,7 @@ from drake_standup.control.controller import (
 from drake_standup.control.model import ControllerModel
 from drake_standup.ports.payloads import COM_REFERENCE, HAND_WRENCHES
 from drake_standup.standup.contact_schedule import ContactSchedule
-from drake_standup.standup.task_references import ReferenceGenerator
+from drake_standup.standup.task_references import CarriedState, ReferenceGenerator, TickInputs
 from drake_standup.standup.transitions import StandupMode
 
 _COMMANDED = DIAGNOSTICS["commanded_normal_force_N"]
@@ -145,18 +145,22 @@ class StandupWholeBodyController(LeafSystem):
         t_terms = time.perf_counter()
         references = self._generator.calc(
             terms,
-            mode.state,
-            self._input("com_reference", context),
-            hands if np.count_nonzero(hands) else None,
-            state.get_value(self._integral),
-            state.get_value(self._posture),
-            state.get_value(self._lean),
-            float(self._input("path_progress", context)[0]),
-            float(state.get_value(self._height_integral)[0]),
-            int(round(self._input("response", context)[0])),
-            state.get_value(self._compliance),
-            self._psi_dot(context),
-            mode.guards.brace.on,
+            TickInputs(
+                standup_state=mode.state,
+                com_reference=self._input("com_reference", context),
+                F_hand_W=hands if np.count_nonzero(hands) else None,
+                path_progress=float(self._input("path_progress", context)[0]),
+                response=int(round(self._input("response", context)[0])),
+                psi_dot=self._psi_dot(context),
+                braced=mode.guards.brace.on,
+            ),
+            CarriedState(
+                momentum_integral=state.get_value(self._integral),
+                posture=state.get_value(self._posture),
+                lean_W=state.get_value(self._lean),
+                height_integral=float(state.get_value(self._height_integral)[0]),
+                compliance=state.get_value(self._compliance),
+            ),
         )
         tick = self.controller.solve(
             terms,

@@ -23,8 +23,10 @@ from drake_standup.standup.task_references import (
     ADVANCEMENT,
     COMPLIANT,
     STIFF,
+    CarriedState,
     PhaseReferences,
     ReferenceGenerator,
+    TickInputs,
 )
 from drake_standup.world.sensing import StandingSupport, standing_lean, standing_pull_usage
 
@@ -112,20 +114,14 @@ def _calc(
     p, v, _, _ = _drake_com(rig)
     if reference is None:
         reference = np.concatenate([p + [0.02, 0.0, -0.01], [0.1, 0.0, 0.05], [0.3, 0.0, 0.1]])
-    return rig["generator"].calc(
-        terms,
-        state,
-        reference,
-        hands,
-        np.zeros(3) if integral is None else integral,
-        np.zeros(2 + 3 * nu),
-        lean,
-        progress,
-        0.0,
-        response,
-        compliance,
-        psi_dot,
-    ), reference
+    now = TickInputs(state, reference, hands, progress, response, psi_dot)
+    carried = CarriedState(
+        momentum_integral=np.zeros(3) if integral is None else integral,
+        posture=np.zeros(2 + 3 * nu),
+        lean_W=lean,
+        compliance=compliance,
+    )
+    return rig["generator"].calc(terms, now, carried), reference
 
 
 def test_the_momentum_target_is_the_com_law_and_the_angular_damping(rig):
@@ -409,7 +405,9 @@ def test_the_posture_filter_steps_as_its_stages_in_series(rig, stages):
     posture, references = np.zeros(2 + 3 * nu), []
     for _ in range(120):
         tick = generator.calc(
-            terms, 2, np.concatenate([p, np.zeros(6)]), None, np.zeros(3), posture
+            terms,
+            TickInputs(2, np.concatenate([p, np.zeros(6)])),
+            CarriedState(momentum_integral=np.zeros(3), posture=posture),
         )
         references.append(tick.q_reference)
         posture = tick.next_posture
@@ -438,25 +436,12 @@ def test_the_generator_integrates_the_angular_momentum_over_its_ticks(rig):
     terms = rig["kinematics"].calc(rig["x"], [])
     p, _, L, _ = _drake_com(rig)
     nu = len(rig["generator"].schedule.q_target_min)
-    integral, posture, lean = np.zeros(3), np.zeros(2 + 3 * nu), np.zeros(3)
+    now = TickInputs(2, np.concatenate([p, np.zeros(6)]), path_progress=0.0)
+    carried = CarriedState(np.zeros(3), np.zeros(2 + 3 * nu), np.zeros(3), 0.0, np.zeros(6))
     for _ in range(4):
-        references = rig["generator"].calc(
-            terms,
-            2,
-            np.concatenate([p, np.zeros(6)]),
-            None,
-            integral,
-            posture,
-            lean,
-            0.0,
-            0.0,
-            ADVANCEMENT,
-            np.zeros(6),
-        )
-        integral, posture = references.next_momentum_integral, references.next_posture
-        lean = references.lean_W
-    np.testing.assert_allclose(integral, 4 * T * L, atol=1e-12)
-    np.testing.assert_array_equal(lean, np.zeros(3))
+        carried = CarriedState.after(rig["generator"].calc(terms, now, carried))
+    np.testing.assert_allclose(carried.momentum_integral, 4 * T * L, atol=1e-12)
+    np.testing.assert_array_equal(carried.lean_W, np.zeros(3))
 
 
 def test_the_psi_clock_blend_is_a_first_order_step_never_slower_than_time():
