@@ -129,6 +129,7 @@ LAYERS = (
 TOP_LEVEL_LIMIT = 12  # modules at the package's top, __init__ included
 MODULE_LINE_LIMIT = 450
 FUNCTION_LINE_LIMIT = 80
+POSITIONAL_LIMIT = 6  # a function's positional parameters (self aside); more go by keyword
 
 
 def _layer(module: str) -> int:
@@ -215,3 +216,30 @@ def test_the_length_check_counts_a_long_function(tmp_path):
     body = "\n".join(f"    x{i} = {i}" for i in range(FUNCTION_LINE_LIMIT))
     path.write_text(f"def f():\n{body}\n")
     assert _long_functions(path) == [f"m.py:f {FUNCTION_LINE_LIMIT + 1}"]
+
+
+def _wide_functions(path: Path) -> list[str]:
+    """Functions taking more than POSITIONAL_LIMIT positional parameters (self and cls
+    aside; keyword-only ones are named at every call)."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            positional = [a.arg for a in node.args.posonlyargs + node.args.args]
+            if positional[:1] in (["self"], ["cls"]):
+                positional = positional[1:]
+            if len(positional) > POSITIONAL_LIMIT:
+                found.append(f"{path.name}:{node.name} {len(positional)}")
+    return found
+
+
+def test_no_function_takes_more_than_six_positional_parameters():
+    assert [f for p in sorted(PACKAGE.rglob("*.py")) for f in _wide_functions(p)] == []
+
+
+def test_the_width_check_finds_a_wide_function(tmp_path):
+    wide = tmp_path / "wide.py"
+    wide.write_text(
+        "def f(a, b, c, d, e, f, g):\n    pass\n\n\n"
+        "def h(self, a, b, c, d, e, f, *, g):\n    pass\n"
+    )
+    assert _wide_functions(wide) == ["wide.py:f 7"]

@@ -88,6 +88,7 @@ def make_program(
     joints: ControllerJoints,
     config: ControllerConfig,
     stance_states: set[int],
+    *,
     torque_limit_Nm: float,
     modes: tuple[int, ...],
     period_s: float = 0.0,
@@ -97,7 +98,7 @@ def make_program(
     arms' (growing with the stance); base orientation; soft joint-limit bounds."""
     contacts = [spec for spec, on in zip(specs, active, strict=True) if on]
     contact_map = ContactMap(contacts, plant.num_velocities())
-    tasks = _tasks(contacts, contact_map, plant, joints, config, stance_states, period_s)
+    tasks = _tasks(contacts, contact_map, plant, joints, config, stance_states, period_s=period_s)
     qp = WholeBodyQp(
         contact_map,
         plant.MakeActuationMatrix(),
@@ -114,8 +115,8 @@ def make_program(
             joints.q_max,
             config.joint_limit_horizon_s,
             config.joint_braking_rad_per_s2,
-            shoulder_tendon_limits(joints.names) if config.shoulder_tendons else None,
-            plant.num_velocities(),
+            linear_limits=shoulder_tendon_limits(joints.names) if config.shoulder_tendons else None,
+            num_velocities=plant.num_velocities(),
         ),
         soft_bound_weight=config.joint_limit_weight,
         solver=config.qp_solver,
@@ -139,6 +140,7 @@ def _tasks(
     joints: ControllerJoints,
     config: ControllerConfig,
     stance_states: set[int],
+    *,
     period_s: float = 0.0,
 ) -> list:
     """The program's tasks, in the order the QP adds their costs (the soles' moment rate
@@ -269,6 +271,7 @@ class WholeBodyController:
         config: ControllerConfig,
         modes: tuple[int, ...],
         stance_modes: set[int],
+        *,
         period_s: float = 0.0,
     ):
         """modes: the values TaskReferences.standup_state takes; stance_modes: those in
@@ -288,9 +291,9 @@ class WholeBodyController:
             joints,
             config,
             set(stance_modes),
-            torque_limit,
-            tuple(modes),
-            period_s,
+            torque_limit_Nm=torque_limit,
+            modes=tuple(modes),
+            period_s=period_s,
         )
         self._programs: dict[tuple[bool, ...], Program] = {}
         # The last contact commands and the program's form of them.

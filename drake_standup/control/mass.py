@@ -28,6 +28,7 @@ def mass_estimate(
     weight_N: float,
     model_weight_N: float,
     blend: float,
+    *,
     bounds: tuple[float, float],
 ) -> tuple[float, bool]:
     """(the estimate, the stand-up has begun) after one tick: weight_N the measured
@@ -51,7 +52,7 @@ def next_mass_state(
     three); the model's scale follows the estimate where they differ by RESCALE_ABOVE."""
     scale, began, model_scale = state
     scale, began = mass_estimate(
-        scale, bool(began), standup_state, weight_N, model_weight_N, blend, bounds
+        scale, bool(began), standup_state, weight_N, model_weight_N, blend, bounds=bounds
     )
     if abs(scale - model_scale) > RESCALE_ABOVE:
         model_scale = scale

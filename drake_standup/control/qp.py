@@ -249,7 +249,7 @@ class WholeBodyQp:
             active_tasks[state] = by_flags[flags]
         return active_tasks
 
-    def _solve_screened(self, backend, H, g, A, lo, hi, equality) -> tuple[np.ndarray, bool]:
+    def _solve_screened(self, backend, H, g, A, lo, hi, *, equality) -> tuple[np.ndarray, bool]:
         """The program (A: its rows) solved without the soft rows of the joints whose limit
         is not in play, and again with those that break their bounds (module docstring).
         z has every entry (the left-out slacks 0)."""
@@ -431,7 +431,7 @@ class WholeBodyQp:
             if backend is None:
                 backend = make_backend(self._solver, *A.shape[::-1])
                 self._programs[k] = A, lo_k, hi_k, equality, backend
-            z, ok = self._solve_screened(backend, H, g, A, lo_k, hi_k, equality)
+            z, ok = self._solve_screened(backend, H, g, A, lo_k, hi_k, equality=equality)
             tau = T @ z
             tau -= r_actuated
             if not ok or np.abs(tau).max() <= self._torque_limit_Nm:

@@ -223,6 +223,7 @@ def add_person(
     X_WP: RigidTransform | None = None,
     name: str = "person",
     table: dict[str, Segment] = DE_LEVA_MALE,
+    *,
     kneeling: bool = False,
 ) -> Person:
     """The module docstring's body, scaled to height_m and mass_kg, standing (or kneeling,

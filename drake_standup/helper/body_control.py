@@ -244,7 +244,7 @@ class PersonController(LeafSystem):
         inertia = discrete_state.get_mutable_value(self._inertia)
         inertia += self._activate * (model.CalcMassMatrix(c) @ ddq - inertia)
         discrete_state.set_value(
-            self._command, self._command_from(context, q, q_d, v_d, grip, inertia, J_grips)
+            self._command, self._command_from(context, q, q_d, v_d, grip, inertia, J_grips=J_grips)
         )
 
     def _command_from(
@@ -255,6 +255,7 @@ class PersonController(LeafSystem):
         v_d: np.ndarray,
         grip: float,
         inertia: np.ndarray,
+        *,
         J_grips: np.ndarray | None = None,
     ) -> np.ndarray:
         """[q_d, v_d, u_ff, grip]: in actuator order the set-point and its rate (model

@@ -190,12 +190,14 @@ class HumanWrenchSource(LeafSystem):
         if self._path is not None:
             return np.array(
                 [
-                    path_force(r, self._path, t, p[i], v[i], start[i], rise, seen[i])
+                    path_force(
+                        r, self._path, t, p[i], v[i], start[i], com_rise_m=rise, seen=seen[i]
+                    )
                     for i in range(2)
                 ]
             )
         return np.array(
-            [reactive_force(r, t, p[i], v[i], start[i], rise, seen[i]) for i in range(2)]
+            [reactive_force(r, t, p[i], v[i], start[i], rise, seen=seen[i]) for i in range(2)]
         )
 
     def _wrenches(self, context: Context) -> np.ndarray:

@@ -42,6 +42,7 @@ def reactive_force(
     v_hand: np.ndarray,
     p_start: np.ndarray,
     com_rise_m: float = 0.0,
+    *,
     seen: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """A person guiding one hand along the direction u of target_velocity_mps, capped. N.
@@ -167,6 +168,7 @@ def path_force(
     p_hand: np.ndarray,
     v_hand: np.ndarray,
     p_start: np.ndarray,
+    *,
     com_rise_m: float,
     seen: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:

@@ -114,7 +114,9 @@ def build_diagram(
             world.GetInputPort("actuation"),
         )
     else:
-        standup = _add_standup_controller(builder, scenario, station, plan, world, human, outputs)
+        standup = _add_standup_controller(
+            builder, scenario, station, plan, world, human, outputs=outputs
+        )
     logs = _export_and_log(builder, outputs, scenario.log_period_s)
     visualizer = None
     if meshcat is not None:
@@ -181,6 +183,7 @@ def _add_standup_controller(
     plan: StandupPlan,
     world: System,
     human: System,
+    *,
     outputs: dict[str, OutputPort],
 ) -> StandupController:
     """The stand-up controller, fed by the station (and the human's stand_up, if it has

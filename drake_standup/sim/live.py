@@ -110,6 +110,7 @@ class LiveHumanSource(LeafSystem):
         meshcat: Meshcat,
         period_s: float,
         stand_up_button: bool = True,
+        *,
         response: int = 0,
     ):
         super().__init__()

@@ -213,6 +213,7 @@ class CoMTarget:
         tau_hand: np.ndarray | None,
         F_hand_W: np.ndarray | None,
         lean_W: np.ndarray | None,
+        *,
         compliance: np.ndarray,
         compliant: bool,
         psi_dot: float = 1.0,

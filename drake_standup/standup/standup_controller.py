@@ -130,7 +130,7 @@ def make_standup_controller(
         joints.q_min,
         joints.q_max,
         station.arm_joints,
-        station.braced_drop_m,
+        braced_drop_m=station.braced_drop_m,
     )
     model = ControllerModel(plant, robot, specs, config, period_s)
     systems = {
@@ -151,8 +151,8 @@ def make_standup_controller(
                 period_s,
                 g,
                 scenario.compliance,
-                partial(standing_lean, support=station.standing),
-                scenario.standup.standing_pull_usage_limit,
+                standing_need=partial(standing_lean, support=station.standing),
+                usage_limit=scenario.standup.standing_pull_usage_limit,
             ),
             WholeBodyController(
                 plant,

@@ -98,6 +98,7 @@ class PhaseReferences:
         q_min: np.ndarray,
         q_max: np.ndarray,
         arm_joints: list[str] = (),
+        *,
         braced_drop_m: float = 0.0,
     ):
         """arm_joints: the joints a brace holds; braced_drop_m: how much lower the CoM
@@ -142,6 +143,7 @@ class ReferenceGenerator:
         period_s: float,
         gravity_mps2: float = 0.0,
         compliance: ComplianceConfig | None = None,
+        *,
         standing_need: Callable | None = None,
         usage_limit: float = 1.0,
     ):
@@ -203,7 +205,7 @@ class ReferenceGenerator:
             state.posture_rad,
             self.schedule.q_target_min,
             self.schedule.q_target_max,
-            blend,
+            blend=blend,
         )
         q_next = q_reference + blend * (q_stage - q_reference) if two_stages else q_stage_next
         next_posture = np.concatenate((self._latched, q_initial, q_next, q_stage_next, (base_yaw,)))
@@ -223,9 +225,9 @@ class ReferenceGenerator:
             tau_hand,
             F_hand_W,
             carried.lean_W,
-            np.zeros(6) if compliance is None else compliance,
-            response == COMPLIANT,
-            psi_dot,
+            compliance=np.zeros(6) if compliance is None else compliance,
+            compliant=response == COMPLIANT,
+            psi_dot=psi_dot,
         )
         stance, vertical_weight_scale = self._stance(state, now.path_progress)
         helped = F_hand_W is not None and response == ADVANCEMENT
@@ -236,8 +238,8 @@ class ReferenceGenerator:
             state.com_kd_per_s,
             carried.momentum_integral,
             stance,
-            carried.height_integral,
-            F_hand_W[3:6] + F_hand_W[9:12] if helped else None,
+            height_integral=carried.height_integral,
+            pull_W=F_hand_W[3:6] + F_hand_W[9:12] if helped else None,
         )
         q_reference, next_posture, base_yaw = self._posture(terms, state, carried.posture, psi_dot)
         return TaskReferences(

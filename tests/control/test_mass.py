@@ -21,19 +21,19 @@ def test_the_estimate_follows_a_first_order_filter():
     """A weight 10 % above the model's measured every tick: s_k = 1.1 - 0.1 (1 - b)^k."""
     scale, began, blend = 1.0, False, 0.04 / 0.3
     for k in range(1, 60):
-        scale, began = mass_estimate(scale, began, 1, 1.1 * 300.0, 300.0, blend, BOUNDS)
+        scale, began = mass_estimate(scale, began, 1, 1.1 * 300.0, 300.0, blend, bounds=BOUNDS)
         assert scale == pytest.approx(1.1 - 0.1 * (1.0 - blend) ** k, rel=1e-12)
     assert not began
 
 
 def test_the_estimate_is_bounded_frozen_once_the_stand_up_begins_or_off():
-    assert mass_estimate(1.0, False, 1, 3.0 * 300.0, 300.0, 1.0, BOUNDS)[0] == 1.3
-    assert mass_estimate(1.0, False, 1, 0.0, 300.0, 1.0, BOUNDS)[0] == 0.7
+    assert mass_estimate(1.0, False, 1, 3.0 * 300.0, 300.0, 1.0, bounds=BOUNDS)[0] == 1.3
+    assert mass_estimate(1.0, False, 1, 0.0, 300.0, 1.0, bounds=BOUNDS)[0] == 0.7
     # State 2 seen: frozen from this tick on, whatever the pads then carry.
-    assert mass_estimate(1.05, False, 2, 600.0, 300.0, 0.5, BOUNDS) == (1.05, True)
-    assert mass_estimate(1.05, True, 1, 600.0, 300.0, 0.5, BOUNDS) == (1.05, True)
+    assert mass_estimate(1.05, False, 2, 600.0, 300.0, 0.5, bounds=BOUNDS) == (1.05, True)
+    assert mass_estimate(1.05, True, 1, 600.0, 300.0, 0.5, bounds=BOUNDS) == (1.05, True)
     # No filter (controller.mass_estimation_filter_s: 0): the nominal model.
-    assert mass_estimate(1.0, False, 1, 600.0, 300.0, 0.0, BOUNDS) == (1.0, False)
+    assert mass_estimate(1.0, False, 1, 600.0, 300.0, 0.0, bounds=BOUNDS) == (1.0, False)
 
 
 def test_the_model_follows_the_estimate_past_the_hysteresis():

@@ -307,7 +307,9 @@ def test_the_momentum_law_is_the_papers_objective_component_by_component():
     target = [0.12, 0.0, 0.52, 0.25, 0.0, 0.05, 0.5, 0.1, -0.2]
     kp, kd = np.array([60.0, 40.0, 30.0]), np.array([15.0, 12.0, 10.0])
     integral = np.array([0.01, 0.02, -0.03])
-    out = law.target(terms, np.array(target), kp, kd, integral, 0.0, 0.0, None)
+    out = law.target(
+        terms, np.array(target), kp, kd, integral, 0.0, height_integral=0.0, pull_W=None
+    )
     expected = []
     for i in range(3):
         expected.append(
@@ -337,11 +339,13 @@ def test_the_momentum_law_lets_through_only_the_pull_along_the_path():
     pull = np.array([20.0, 5.0, 10.0])
     along = 20.0 * 0.6 + 10.0 * 0.8
     for stance in (0.0, 0.5):
-        out = law.target(terms, target, kp, kd, np.zeros(3), stance, 0.0, pull)
+        out = law.target(
+            terms, target, kp, kd, np.zeros(3), stance, height_integral=0.0, pull_W=pull
+        )
         f_par = (1.0 - stance) * along * np.array([0.6, 0.0, 0.8])
         np.testing.assert_allclose(out.helpful_force_W, f_par, atol=1e-12)
         np.testing.assert_allclose(out.Ldot_star[3:5], f_par[:2], atol=1e-12)
-    against = law.target(terms, target, kp, kd, np.zeros(3), 0.0, 0.0, -pull)
+    against = law.target(terms, target, kp, kd, np.zeros(3), 0.0, height_integral=0.0, pull_W=-pull)
     np.testing.assert_array_equal(against.helpful_force_W, np.zeros(3))
 
 
@@ -353,13 +357,15 @@ def test_the_stance_height_integral_accumulates_and_is_bounded():
     terms = _terms_at([0.0, 0.0, 0.50], np.zeros(3), np.zeros(6), 33.0)
     target = np.array([0.0, 0.0, 0.52, 0, 0, 0, 0, 0, 0])
     zero = np.zeros(3)
-    out = law.target(terms, target, zero, zero, zero, 0.5, 0.001, None)
+    out = law.target(terms, target, zero, zero, zero, 0.5, height_integral=0.001, pull_W=None)
     integral = 0.001 + 0.004 * 0.5 * 0.02
     assert out.next_height_integral == pytest.approx(integral, rel=1e-12)
     ki = config.stance_height_ki_per_s3
     assert out.Ldot_star[5] == pytest.approx(33.0 * ki * integral, rel=1e-12)
     limit = 0.2 * 9.81 / ki
-    saturated = law.target(terms, target, zero, zero, zero, 1.0, 10.0 * limit, None)
+    saturated = law.target(
+        terms, target, zero, zero, zero, 1.0, height_integral=10.0 * limit, pull_W=None
+    )
     assert saturated.next_height_integral == pytest.approx(limit, rel=1e-12)
 
 
@@ -373,7 +379,7 @@ def test_the_posture_reference_is_a_first_order_filter():
     blend = 0.04
     q = q0.copy()
     for _ in range(25):
-        q = next_posture_reference(q0, q, hold, target, low, high, blend)
+        q = next_posture_reference(q0, q, hold, target, low, high, blend=blend)
     goal = np.array([0.1, -0.2, 1.5])  # the held joint: 2.0 clamped to 1.5
     np.testing.assert_allclose(q, goal + (q0 - goal) * (1.0 - blend) ** 25, rtol=1e-12)
 

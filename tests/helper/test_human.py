@@ -242,7 +242,7 @@ def _pull(cfg, t, s_hand=0.0, v_along=0.0, rise=0.0, sideways=0.0, v_sideways=0.
     side = np.array([0.0, 1.0, 0.0])
     p = START + s_hand * DIR + sideways * side
     v = v_along * DIR + v_sideways * side
-    return path_force(cfg, Path(cfg.path_xz_m), t, p, v, START, rise)
+    return path_force(cfg, Path(cfg.path_xz_m), t, p, v, START, com_rise_m=rise)
 
 
 def test_path_arc_length_and_closest_point():
@@ -340,7 +340,7 @@ def test_path_pull_turns_through_a_corner_along_the_path():
     cfg = _path_cfg(path_xz_m=[[0.4, 0.3], [0.4, 1.3]], lead_min_m=0.2, lead_max_m=0.2)
     path = Path(cfg.path_xz_m)
     p = START + np.array([0.32, 0.0, 0.24])  # 0.4 m along the first leg (0.8, 0.6)
-    f = path_force(cfg, path, 2.0, p, np.zeros(3), START, 0.0)
+    f = path_force(cfg, path, 2.0, p, np.zeros(3), START, com_rise_m=0.0)
     chord = np.array([0.4, 0.4]) - np.array([0.32, 0.24])
     direction = chord / np.linalg.norm(chord)
     np.testing.assert_allclose(f, 100.0 * 0.2 * np.array([direction[0], 0.0, direction[1]]))
@@ -444,7 +444,9 @@ def test_person_acts_on_what_they_saw_their_reaction_time_ago():
     zero = np.zeros(3)
 
     def expected(t, seen, rise):
-        return [reactive_force(cfg, t, p_b[i], zero, p_a[i], rise, (seen[i], zero)) for i in (0, 1)]
+        return [
+            reactive_force(cfg, t, p_b[i], zero, p_a[i], rise, seen=(seen[i], zero)) for i in (0, 1)
+        ]
 
     np.testing.assert_allclose(force(0.19), expected(0.19, p_a, 0.0), atol=1e-12)
     late = force(0.21)

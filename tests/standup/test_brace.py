@@ -127,7 +127,13 @@ def test_braced_phase_references_hold_the_arms_and_lower_the_leaning_com():
     joints = ControllerJoints.of(scene.plant, scene.robot)
     arms = arm_joint_names(scene.plant, scene.robot)
     schedule = PhaseReferences(
-        TABLE, ControllerConfig(), joints.names, joints.q_min, joints.q_max, arms, 0.02
+        TABLE,
+        ControllerConfig(),
+        joints.names,
+        joints.q_min,
+        joints.q_max,
+        arms,
+        braced_drop_m=0.02,
     )
     is_arm = np.isin(joints.names, arms)
     for state, phase in enumerate(TABLE, start=1):

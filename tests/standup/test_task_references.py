@@ -242,8 +242,8 @@ def test_the_compliant_offset_settles_only_where_the_standing_feet_hold_the_pull
         T,
         rig["g"],
         None,
-        partial(standing_lean, support=SUPPORT),
-        limit,
+        standing_need=partial(standing_lean, support=SUPPORT),
+        usage_limit=limit,
     )
     _, _, _, mass = _drake_com(rig)
     weight = mass * rig["g"]

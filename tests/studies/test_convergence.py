@@ -349,7 +349,7 @@ def test_a_run_that_cannot_start_replaces_the_old_runs_files(tmp_path):
     _write_run(tmp_path / case.name, synthetic_run(), old)
     bad = "duration_s: -1.0\n"
     inputs = case_inputs(case, bad, 5.0)
-    metrics = run_case(bad, "bad", 0.002, 0.002, 5.0, str(tmp_path / case.name), inputs)
+    metrics = run_case(bad, "bad", 0.002, 0.002, 5.0, str(tmp_path / case.name), inputs=inputs)
     assert metrics["success"] is False and "duration_s" in metrics["failure_reason"]
     assert not is_cached(tmp_path / case.name, old)
     assert not is_cached(tmp_path / case.name, inputs)

@@ -24,6 +24,7 @@ class JointLimitBounds:
         q_max: np.ndarray,
         horizon_s: float,
         braking_rad_per_s2: float | None = None,
+        *,
         linear_limits: tuple[np.ndarray, np.ndarray] | None = None,
         num_velocities: int | None = None,
     ):

@@ -129,6 +129,7 @@ class MomentumLaw:
         kd_per_s: np.ndarray,
         momentum_integral: np.ndarray,
         stance: float,
+        *,
         height_integral: float,
         pull_W: np.ndarray | None,
     ) -> MomentumTarget:

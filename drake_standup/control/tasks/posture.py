@@ -33,6 +33,7 @@ class PostureTask(Task):
         weights: np.ndarray,
         kp_per_s2: float,
         damping_ratio: float,
+        *,
         name: str = "posture",
         active_states: frozenset[int] | None = None,
     ):
@@ -86,6 +87,7 @@ def next_posture_reference(
     target_rad: np.ndarray,
     q_target_min: np.ndarray,
     q_target_max: np.ndarray,
+    *,
     blend: float,
 ) -> np.ndarray:
     """q_ref's next value: q_ref + blend (q_target - q_ref), q_target the state's posture

@@ -28,6 +28,7 @@ def run_case(
     controller_period_s: float,
     duration_s: float,
     out_dir: str,
+    *,
     inputs: dict,
     overrides: list | tuple = (),
 ) -> dict:

@@ -101,7 +101,17 @@ def run_study(
         record["inputs"] = inputs[case]
         record["reused"] = case not in todo
     choice = choose(records, scenarios)
-    study = _study(records, choice, scenarios, steps_ms, durations, overrides, wall_s, todo, cases)
+    study = _study(
+        records,
+        choice,
+        scenarios,
+        steps_ms,
+        durations,
+        overrides,
+        wall_s=wall_s,
+        todo=todo,
+        cases=cases,
+    )
     files = [out_dir / "convergence.json", out_dir / "convergence.md", out_dir / "convergence.png"]
     write_json(files[0], _inf_as_text(study))
     files[1].write_text(markdown(records, choice, wall_s if todo else None, overrides))
@@ -145,6 +155,7 @@ def _study(
     steps_ms: list[float],
     durations: dict[str, float],
     overrides: list | tuple,
+    *,
     wall_s: float,
     todo: list[Case],
     cases: list[Case],
