@@ -89,6 +89,8 @@ def prose(path: Path) -> str:
     import tokenize
 
     text = path.read_text()
+    if path.suffix == ".toml":  # its [sections] are syntax: the comments only
+        return "\n".join(line for line in text.splitlines() if line.lstrip().startswith("#"))
     if path.suffix != ".py":
         return text
     parts = [
@@ -306,3 +308,27 @@ def missing_commits(hashes: set[str]) -> list[str]:
         for line in done.stdout.splitlines()
         if line.endswith("missing") or "ambiguous" in line
     )
+
+
+REFERENCES_MD = REPO / "docs" / "references.md"
+# A citation of an entry of docs/references.md: [authors-code], [nava2016].
+_CITATION = re.compile(r"\[([a-z][a-z0-9]*(?:-[a-z0-9]+)+|[a-z]+\d{4})\](?!\()")
+
+
+def reference_keys(text: str | None = None) -> set[str]:
+    """The entries of docs/references.md (each opens with **[key]**)."""
+    text = REFERENCES_MD.read_text() if text is None else text
+    return set(re.findall(r"^\*\*\[([^\]]+)\]\*\*", text, re.M))
+
+
+def unknown_citations(path: Path, text: str | None = None) -> list[str]:
+    """[key] citations in a file's prose that docs/references.md has no entry for."""
+    text = prose(path) if text is None else text
+    return sorted(set(_CITATION.findall(text)) - reference_keys())
+
+
+def outside_citations(path: Path, text: str | None = None) -> list[str]:
+    """Citations of the team's brief outside the repository (SPEC 3, SPEC section 9,
+    ../shared/): a reader cannot follow them."""
+    text = prose(path) if text is None else text
+    return re.findall(r"\bSPEC(?:\s+section)?\s+\d+|\.\./shared/\S*", text)

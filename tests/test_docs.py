@@ -22,7 +22,10 @@ from docs_check import (
     missing_paths,
     missing_sections,
     named_commits,
+    outside_citations,
+    reference_keys,
     undocumented_metrics,
+    unknown_citations,
 )
 
 # Sources whose docstrings and comments name files and sections.
@@ -73,6 +76,26 @@ def test_every_commit_a_doc_names_is_in_the_history():
     assert missing_commits(named) == []
 
 
+@pytest.mark.parametrize("path", DOCUMENTS + SOURCES, ids=_ids(DOCUMENTS + SOURCES))
+def test_every_citation_is_an_entry_of_the_references(path):
+    """Sources are cited by their docs/references.md entry ([authors-code]) or by the
+    paper, never by a file outside the repository."""
+    assert unknown_citations(path) == []
+    assert outside_citations(path) == []
+
+
+def test_the_references_are_cited():
+    """Each entry is cited somewhere in the package, scenarios, sweeps or docs, and the
+    entries the code leans on most are there."""
+    keys = reference_keys()
+    assert {"tirupachuri2019", "nava2016", "authors-code", "icub-logs", "early-probe"} <= keys
+    cited = set()
+    for path in DOCUMENTS + SOURCES:
+        if path != docs_check.REFERENCES_MD:
+            cited |= set(docs_check._CITATION.findall(docs_check.prose(path)))
+    assert keys - cited == set()
+
+
 def test_the_checks_find_a_name_broken_on_purpose(tmp_path):
     """Each check above, on a copy of a true text with one name broken."""
     design = REPO / "docs" / "design.md"
@@ -101,6 +124,13 @@ def test_the_checks_find_a_name_broken_on_purpose(tmp_path):
     ]
     if (REPO / ".git").exists():
         assert missing_commits({"0000000abc"}) == ["0000000abc"]
+    assert unknown_citations(doc, "K_P 1 ([authors-code]); mu ([no-such-entry])") == [
+        "no-such-entry"
+    ]
+    assert outside_citations(doc, "friction 1/3 (SPEC 3; ../shared/SPEC.md)") == [
+        "SPEC 3",
+        "../shared/SPEC.md)",
+    ]
     assert named_commits("at 745f4cd, not 1234567 nor abcdefa") == {"745f4cd"}
     assert docs_check.slug("Issue 46, fifth part: the soles' last slaps") == (
         "issue-46-fifth-part-the-soles-last-slaps"

@@ -12,9 +12,9 @@ from drake_standup.config.resources import data_root
 
 
 def _seated_joints() -> dict[str, float]:
-    # SPEC section 3 (authors' seated pose), with the feasibility probe's knee
+    # [authors-code] (authors' seated pose), with the feasibility probe's knee
     # (-1.7365 rad) and the ankle pitch that puts the soles flat on the floor
-    # for that knee (SPEC section 7: the window for feet on the floor is narrow).
+    # for that knee ([early-probe]: the window for feet on the floor is narrow).
     legs = {
         "hip_pitch": 1.5908,
         "hip_roll": 0.2141,
@@ -66,9 +66,8 @@ SEATED_BASE_XYZ_M = [0.0, 0.0, 0.39]
 @dataclass
 class Cushion:
     """A soft seat: a compliant hydroelastic layer on the seat board. Upholstery foams'
-    Young's modulus is of order 10-100 kPa (flexible polyurethane foams: Gibson & Ashby,
-    Cellular Solids, 2nd ed., ch. 5); Drake's hydroelastic modulus is taken as about E
-    (Elandt et al., IROS 2019)."""
+    Young's modulus is of order 10-100 kPa (flexible polyurethane foams: [gibson-ashby]);
+    Drake's hydroelastic modulus is taken as about E ([elandt2019])."""
 
     # Hydroelastic modulus. Pa.
     modulus_Pa: float = 1.0e5
@@ -86,7 +85,7 @@ class ChairConfig:
     or an SDF file of your own."""
 
     # The seat's top above the chair's frame (on the floor): 0.2195 m is where the
-    # iCubGazeboV2_5's pads rest in the authors' seated pose (SPEC 10; their Gazebo chair
+    # iCubGazeboV2_5's pads rest in the authors' seated pose ([authors-code]; their Gazebo chair
     # had about 0.2075 m). With `file`, say where your chair's seat top is. m.
     seat_height_m: float = 0.2195
     # None: a rigid seat; else a soft layer on top of the board (Cushion).

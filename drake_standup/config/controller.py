@@ -15,13 +15,13 @@ class ControllerConfig:
     """Gains, weights and contact limits of the whole-body controller; what changes with
     the stand-up state (CoM gains, postures, base pitch, lean) is the phase table's."""
 
-    # K_D = 2 zeta sqrt(K_P), critically damped (SPEC 7).
+    # K_D = 2 zeta sqrt(K_P), critically damped ([early-probe]).
     com_damping_ratio: float = 1.0
-    # Angular momentum: Ldot_ang* = -K_D L_ang - K_P int L_ang; K_P,ang = 1 (SPEC 3). 1/s^2.
+    # Angular momentum: Ldot_ang* = -K_D L_ang - K_P int L_ang; K_P,ang = 1 ([authors-code]). 1/s^2.
     angular_momentum_kp_per_s2: float = 1.0
-    # Angular momentum damping K_D,ang (SPEC 7 probe: 5). 1/s.
+    # Angular momentum damping K_D,ang ([early-probe]: 5). 1/s.
     angular_momentum_kd_per_s: float = 5.0
-    # Joint posture: qddot* = -K_P (q - q_ref) - K_D qdot (SPEC 7 probe: 30). 1/s^2.
+    # Joint posture: qddot* = -K_P (q - q_ref) - K_D qdot ([early-probe]: 30). 1/s^2.
     posture_kp_per_s2: float = 30.0
     # K_D = 2 zeta sqrt(K_P) for the posture, critically damped.
     posture_damping_ratio: float = 1.0
@@ -33,7 +33,7 @@ class ControllerConfig:
     # starts q_ref at its fastest rate (the gap over tau) at every switch; two start it at
     # rest (docs/design.md, "The limbs the trunk carries"). 1 or 2.
     posture_filter_stages: int = 2
-    # Posture targets are clamped this far inside the joint limits: SPEC 3's elbow target
+    # Posture targets are clamped this far inside the joint limits: [authors-code]'s elbow target
     # 0.2473 rad lies below the URDF's 0.262 limit. rad.
     posture_limit_margin_rad: float = 0.05
     # Acceleration bounds stop every actuated joint at its limits within this horizon
@@ -52,7 +52,7 @@ class ControllerConfig:
     # limits are: soft rows with the same horizon, braking and weight.
     shoulder_tendons: bool = True
     # Base (root_link) orientation: upright at the yaw of the first tick, pitched forward
-    # by the phase's base_pitch_rad. The probe ended stooped 25 deg (SPEC 7). 1/s^2.
+    # by the phase's base_pitch_rad. The probe ended stooped 25 deg ([early-probe]). 1/s^2.
     base_orientation_kp_per_s2: float = 30.0
     # K_D = 2 zeta sqrt(K_P) for the base orientation.
     base_orientation_damping_ratio: float = 1.0
@@ -90,15 +90,15 @@ class ControllerConfig:
     torque_weight: float = 1.0e-4
     wrench_weight: float = 1.0e-5
     acceleration_weight: float = 1.0e-6
-    # Linearised friction pyramid |f_t| <= mu f_z of the QP (SPEC 3; the pads have 1.0).
+    # Linearised friction pyramid |f_t| <= mu f_z of the QP ([authors-code]; the pads have 1.0).
     friction_coefficient: float = 1.0 / 3.0
-    # Torsional friction |tau_z| <= mu_t f_z (SPEC 3). m.
+    # Torsional friction |tau_z| <= mu_t f_z ([authors-code]). m.
     torsional_friction_coefficient_m: float = 1.0 / 75.0
     # A held contact's rows ask J vdot + Jdot v = -k J v: a foot that has begun to slip
     # (a pull the pads' friction barely holds) is braked back to rest instead of being
     # left to drift (docs/design.md, "Leaving the seat"). 1/s.
     contact_velocity_gain_per_s: float = 20.0
-    # Minimum normal force of a seated pad and of each sole (SPEC 3). N.
+    # Minimum normal force of a seated pad and of each sole ([authors-code]). N.
     min_normal_force_N: float = 10.0
     # A seated pad's normal-force bound: above the robot's weight (324 N), never binding. N.
     seat_max_normal_force_N: float = 400.0
@@ -112,7 +112,7 @@ class ControllerConfig:
     seat_pad_dynamics: bool = False
     # Sole normal-force bound: three times the robot's weight, never binding. N.
     foot_max_normal_force_N: float = 1000.0
-    # CoP box of each sole in its l_sole/r_sole frame (SPEC 3; inside the 0.19 x 0.09 m
+    # CoP box of each sole in its l_sole/r_sole frame ([authors-code]; inside the 0.19 x 0.09 m
     # pads at x in [-0.064, 0.126], models/icub_contact.yaml). m.
     foot_cop_x_m: list[float] = field(default_factory=lambda: [-0.05, 0.10])
     foot_cop_y_m: list[float] = field(default_factory=lambda: [-0.025, 0.025])
@@ -127,10 +127,10 @@ class ControllerConfig:
     thigh_cop_x_m: list[float] = field(default_factory=lambda: [-0.05, 0.05])
     thigh_cop_y_m: list[float] = field(default_factory=lambda: [-0.025, 0.025])
     # Joint torque saturation, N m. None: the actuators' effort limit in the plant
-    # (robot.effort_limit_Nm, SPEC 3); a number: a tighter limit of the controller's own.
+    # (robot.effort_limit_Nm, [authors-code]); a number: a tighter limit of the controller's own.
     torque_limit_Nm: float | None = None
     # ||xd_dot|| below which the helpful part of the pull fades out (smoothstep): the
-    # standing robot compensates the whole pull (SPEC 7). m/s.
+    # standing robot compensates the whole pull ([early-probe]). m/s.
     help_fade_speed_mps: float = 0.02
     # CoM lead over its reference along the path at which the help is fully compensated:
     # a pull cannot carry the CoM past its reference (and past the standing height). m.

@@ -1,4 +1,5 @@
-"""The phase table: what each stand-up state does, declared once (SPEC 3, 7).
+"""The phase table: what each stand-up state does, declared once ([authors-code],
+[early-probe]; the postures: the authors' state 2, 3 and 4).
 
 A scenario's `phases:` section holds one Phase per state; the defaults below are the
 table every consumer reads: the state machine (segments, guards, the answer to a
@@ -8,9 +9,9 @@ posture, base orientation, lean, stance).
 
     state  phase     CoM K_P       posture        base   seat              lean  stance  psi
     1      seated    [60, 40, 5]   as it sits     0.0    held              -     -       = t
-    2      forward   [60, 40, 5]*  SPEC 3 st. 2   0.4    buttocks unload   -     -       advances
-    3      lift_off  [60, 40, 30]  SPEC 3 st. 3   0.3    thighs unload     yes   -       advances
-    4      rise      [60, 40, 30]  SPEC 3 st. 4   0.0    off the chair     yes   yes     advances
+    2      forward   [60, 40, 5]*  authors' st. 2 0.4    buttocks unload   -     -       advances
+    3      lift_off  [60, 40, 30]  authors' st. 3 0.3    thighs unload     yes   -       advances
+    4      rise      [60, 40, 30]  authors' st. 4 0.0    off the chair     yes   yes     advances
 
     * forward's CoM height is not tracked (com_height_follows): its reference height is
       the measured CoM's, so the z gain only damps; state 3 starts its height there.
@@ -48,7 +49,7 @@ _ARMS = ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
 
 
 def posture(values: list[float]) -> dict[str, float]:
-    """A SPEC 3 posture row [hip pitch, roll, knee, ankle pitch | shoulder pitch, roll, yaw,
+    """A [authors-code] posture row [hip pitch, roll, knee, ankle pitch | shoulder pitch, roll, yaw,
     elbow | torso pitch], both sides alike, as joint name -> rad."""
     table = {
         f"{side}_{joint}": value
@@ -79,7 +80,7 @@ class Guard:
     feet_force_N: float | None = None
     # Each sole carries more than this. N.
     each_foot_force_N: float | None = None
-    # The CoM at least this far in front of the soles' heel edge (SPEC 7: the feet's
+    # The CoM at least this far in front of the soles' heel edge ([early-probe]: the feet's
     # forces alone fired with the CoM behind the heels). m.
     com_ahead_of_heels_m: float | None = None
 
@@ -122,7 +123,7 @@ class Phase:
     # The posture's seated leg joints (hip pitch, knee, ankle pitch: those the seating
     # solves) move with the seated pose: posture_rad holds their targets for the shipped
     # seated pose (config.chair.SEATED_JOINTS), and the plan adds how far the robot's own
-    # seated pose differs from it (resolve_postures), so a phase keeps SPEC 3's motion
+    # seated pose differs from it (resolve_postures), so a phase keeps [authors-code]'s motion
     # from the seat wherever the robot sits. False: posture_rad as it is.
     posture_from_seated: bool = False
     # Forward pitch of the base's (root_link's) target orientation. rad.
@@ -155,7 +156,7 @@ class PhaseTable:
     """The four phases, in the order of the stand-up states (PHASES). The last is final:
     its exit is never taken."""
 
-    # 1: balance on the chair (SPEC 3), the initial posture held.
+    # 1: balance on the chair ([authors-code]), the initial posture held.
     seated: Phase = field(
         default_factory=lambda: Phase(
             segment_psi=1.5,
@@ -163,9 +164,9 @@ class PhaseTable:
             exit=Guard(min_time_s=3.0, asked=True),
         )
     )
-    # 2: the CoM forward over the feet (SPEC 3: [0.1277, -0.0295, 0]; the lateral part
+    # 2: the CoM forward over the feet ([authors-code]: [0.1277, -0.0295, 0]; the lateral part
     # belonged to the authors' asymmetric posture, ours is symmetric), the pelvis pitched
-    # forward; the buttocks lift off the seat. SPEC 3's 0.1277 m, measured from the
+    # forward; the buttocks lift off the seat. [authors-code]'s 0.1277 m, measured from the
     # shipped seated pose, ends 8.1 mm behind the soles' frames: kept there on any seat.
     # Its height follows the CoM: the path's z (0 displacement, K_P 5) pulled back toward
     # the seated height while the pitch dipped the CoM, and state 3 restarted 37-66 mm
@@ -189,8 +190,8 @@ class PhaseTable:
             exit=Guard(unloaded=True, feet_force_N=150.0, com_ahead_of_heels_m=0.03),
         )
     )
-    # 3: the CoM further forward (SPEC 3), its height stiffened from where it is; the
-    # thighs lift off the seat. Over 0.7 s, not SPEC 3's 0.5 s: the min-jerk path's
+    # 3: the CoM further forward ([authors-code]), its height stiffened from where it is; the
+    # thighs lift off the seat. Over 0.7 s, not [authors-code]'s 0.5 s: the min-jerk path's
     # 0.92 m/s^2 forward needs the CoP 3 cm behind the CoM at its 0.32 m height, at the
     # soles' heel edge, past their pads' middle third; the toes lifted and slapped (up to
     # 76 N of sole chatter). 0.7 s needs 0.47 m/s^2 (issue 30, docs/design.md).
@@ -207,7 +208,7 @@ class PhaseTable:
             base_pitch_rad=0.3,
             seat_hold="hinged",
             unload=["thighs"],
-            # Over the whole phase, as SPEC 3's 0.5 s of both: released earlier, the free
+            # Over the whole phase, as [authors-code]'s 0.5 s of both: released earlier, the free
             # thighs brushed the seat again while the CoM still moved forward at its height.
             unload_s=0.7,
             lean=True,

@@ -17,14 +17,14 @@ from drake_standup.config.resources import data_root
 
 SCENARIO_DIR = data_root() / "scenarios"
 DEFAULT_SCENARIO = SCENARIO_DIR / "assisted.yaml"
-# Every actuator's effort limit: the paper's torque saturation (SPEC 3). N m.
+# Every actuator's effort limit: the paper's torque saturation ([authors-code]). N m.
 EFFORT_LIMIT_NM = 60.0
 
 
 # robot.reflected_inertia's settings (robot.reflects_motor_inertia).
 REFLECTED_INERTIA = ("none", "all", "real_robots")
-# response's settings, the robot's answer to a pull (SPEC 1; the paper's introduction names
-# the three): its index is the response code the controller's systems read.
+# response's settings, the robot's answer to a pull ([tirupachuri2019]; the paper's
+# introduction names the three): its index is the response code the controller's systems read.
 RESPONSES = ("advancement", "stiff", "compliant")
 
 
@@ -32,7 +32,7 @@ RESPONSES = ("advancement", "stiff", "compliant")
 class RobotConfig:
     # Any name from icub_models.get_robot_names().
     model: str = "iCubGazeboV2_5"
-    # Replace massless sensor/skin links by frames (SPEC 5: 3-10x faster terms).
+    # Replace massless sensor/skin links by frames ([drake-docs]: 3-10x faster terms).
     reduced: bool = True
     # Every actuator's effort limit, which the controller reads from the plant. N m.
     effort_limit_Nm: float = EFFORT_LIMIT_NM
@@ -43,7 +43,7 @@ class RobotConfig:
     # The motors' reflected inertia (gear ratio^2 x rotor inertia on each actuated
     # joint, robot/icub.py MOTOR_INERTIAS), in the plant and the controller's model alike:
     # none | all | real_robots (every model but the Gazebo ones). As the authors had it
-    # (SPEC 9: on for the real robots, off in Gazebo); the convergence study found it
+    # ([authors-code]: on for the real robots, off in Gazebo); the convergence study found it
     # cheaper per step and converged at a larger step (docs/performance.md).
     reflected_inertia: str = "real_robots"
 
@@ -64,9 +64,9 @@ class Pull:
 @dataclass
 class ReactiveHumanConfig:
     """A helper who guides each hand; the pull fades in and out over ramp_s
-    (SPEC 3: the authors' human pulled 10-25 N per hand).
+    ([authors-code]: the authors' human pulled 10-25 N per hand).
 
-    Both guides are a person (issue 31, SPEC 10): they decide on what they saw
+    Both guides are a person (issue 31, [reaction-time]): they decide on what they saw
     reaction_time_s ago, follow a hand that outruns them and let go once the robot
     is up (ease_com_rise_m).
     guide: velocity (the default): a person moving each hand along the direction
@@ -84,7 +84,7 @@ class ReactiveHumanConfig:
     guide: str = "velocity"
     # What the person does is decided on what they saw this long ago; their arm's
     # impedance acts at once. A person's simple reaction time to a felt force is about
-    # 0.15-0.25 s (SPEC 10), but the default is 0 (decisions at once, as the first
+    # 0.15-0.25 s ([reaction-time]), but the default is 0 (decisions at once, as the first
     # models) until the stand-up tells a partner who lags from one who hinders: at 0.2 s
     # the shipped reactive partner stands the robot up 14 % sooner than alone, not 18 %
     # (issue 31, docs/design.md). s.
@@ -95,7 +95,7 @@ class ReactiveHumanConfig:
     # Arm-like stiffness and damping of a person guiding a hand. N/m, N s/m.
     stiffness_N_per_m: float = 150.0
     damping_Ns_per_m: float = 20.0
-    # Per hand; the authors' human pulled 10-25 N (SPEC 3). N.
+    # Per hand; the authors' human pulled 10-25 N ([authors-code]). N.
     force_cap_N: float = 20.0
     # guide: velocity.
     target_velocity_mps: list[float] = field(default_factory=lambda: [0.10, 0.0, 0.10])
@@ -116,7 +116,7 @@ class ReactiveHumanConfig:
     # The target's distance ahead of the hand along the path: at most
     # lead_max_m (no yank: the spring's pull stays under K lead_max), at least
     # lead_min_m (the person keeps pulling a hand that outruns the pace, with
-    # K lead_min: 22.5 N at 150 N/m, within SPEC 3's 10-25 N). The velocity
+    # K lead_min: 22.5 N at 150 N/m, within [authors-code]'s 10-25 N). The velocity
     # guide keeps lead_min_m too, ahead of a hand that outruns its pace. m.
     lead_min_m: float = 0.15
     lead_max_m: float = 0.20
@@ -145,9 +145,9 @@ class AdvancementConfig:
     # tangent: the paper's proposition, psi_dot = clip(xdot . d_psi x_d /
     #   (|d_psi x_d|^2 + eps)), applied while the interaction helps (alpha >
     #   alpha_min). interaction: the authors' code, the same ratio measured along
-    #   Omega f (SPEC 2).
+    #   Omega f ([tirupachuri2019]).
     law: str = "tangent"
-    # Upper bound of psi_dot; the authors' last setting (earlier 5). SPEC 3.
+    # Upper bound of psi_dot; the authors' last setting (earlier 5). [authors-code].
     psi_dot_upper: float = 2.5
     # Regulariser of the denominators, m^2 (per unit psi^2): 0.4% of the
     # squared peak tangent of the state-2 segment (|d_psi x_d| <= 0.16 m), so it
@@ -163,8 +163,8 @@ class AdvancementConfig:
     # each hand along the path gives its mass (advancement.for_robot). m/s^2.
     alpha_full_mps2: float | None = None
     # Per hand: the law acts in full from a trained helper's pull on. The real
-    # iCub's trained helper peaked at 13.3/9.9 N per hand (SPEC 9), the authors'
-    # human pulled 10-25 N (SPEC 3): 0.60 m/s^2 on iCubGazeboV2_5 (33 kg; it was
+    # iCub's trained helper peaked at 13.3/9.9 N per hand ([icub-logs]), the authors'
+    # human pulled 10-25 N ([authors-code]): 0.60 m/s^2 on iCubGazeboV2_5 (33 kg; it was
     # a fixed 0.9, the default 15 + 15 N pull's peak, which gave a 15 N partner 2/3
     # of the law; issue 31, docs/design.md). N.
     full_help_pull_N: float = 10.0
@@ -201,11 +201,11 @@ class ComplianceConfig:
     on the feet alone not above the path (standup/task_references.py)."""
 
     # The robot's own mass (iCubGazeboV2_5: 33 kg): the reference yields to the pull as
-    # the robot itself would, free, at first (Omega f = f / m, SPEC 2). kg.
+    # the robot itself would, free, at first (Omega f = f / m, [tirupachuri2019]). kg.
     virtual_mass_kg: float = 33.0
-    # The top of a realistic helper's envelope, 2 x 26 N (SPEC 9: an untrained person's
+    # The top of a realistic helper's envelope, 2 x 26 N ([icub-logs]: an untrained person's
     # peak per hand), reaches the forward bound: 52 N / 0.04 m. A trained helper's
-    # 13 + 10 N (SPEC 9) yields 1.8 cm. N/m.
+    # 13 + 10 N ([icub-logs]) yields 1.8 cm. N/m.
     stiffness_N_per_m: float = 1300.0
     # Critically damped: the offset follows a steady pull without overshoot.
     damping_ratio: float = 1.0
@@ -217,8 +217,9 @@ class ComplianceConfig:
 
 @dataclass
 class StandupConfig:
-    """The state machine's settings across phases (SPEC 3, 7); what each state does, and
-    the guard that leaves it, is the phase table (phases.py). Reasons: docs/design.md."""
+    """The state machine's settings across phases ([authors-code], [early-probe]); what each
+    state does, and the guard that leaves it, is the phase table (phases.py). Reasons:
+    docs/design.md."""
 
     # hands: state 1 -> 2 needs the pull (both hands, x force > threshold) or the live
     # page's button; time: the balancing time alone.
@@ -227,8 +228,8 @@ class StandupConfig:
     hand_force_threshold_N: float = 10.0
     # ... or a gentler pull held longer: both hands pulled the stand-up's way (forward
     # and up, guards.helping_pull_N) by more than the real iCub's hands register with
-    # nobody helping (SPEC 9: 5.4/6.5 N peak, states 2-3), for a person's reaction time
-    # (SPEC 10: 0.15-0.25 s). A firm pull starts it at once, a gentle grip once it is
+    # nobody helping ([icub-logs]: 5.4/6.5 N peak, states 2-3), for a person's reaction time
+    # ([reaction-time]: 0.15-0.25 s). A firm pull starts it at once, a gentle grip once it is
     # plainly meant (issue 31: 12 of 48 partners, 8-26 N grips, never started at 10 N;
     # 2 more, 9 N along a 45-degree pace, on the forward force alone). N, s.
     gentle_pull_force_N: float = 6.5
@@ -266,7 +267,7 @@ class StandupConfig:
     guard_dwell_s: float = 0.05
     guard_off_ratio: float = 0.8
     # Period of the state machine's update; the authors' whole controller ran at 100 Hz
-    # (SPEC 3), and the guards' thresholds are met for seconds. s.
+    # ([authors-code]), and the guards' thresholds are met for seconds. s.
     update_period_s: float = 0.01
 
 
@@ -357,7 +358,7 @@ class Scenario:
     robot: RobotConfig = field(default_factory=RobotConfig)
     # Simulated time. s.
     duration_s: float = 5.0
-    # Drake's own plant settings: discrete 'similar' (SPEC 5: 'lagged' and
+    # Drake's own plant settings: discrete 'similar' ([drake-docs]: 'lagged' and
     # 'similar' ran 1.4-2.2x faster than real time, SAP 0.6x), stepped at 4 ms for
     # speed: in the convergence study (python -m drake_standup.studies.convergence,
     # docs/performance.md) 4 ms keeps every stand-up time within 0.04 s of 1 ms but
@@ -404,7 +405,7 @@ class Scenario:
     # The momentum-based whole-body controller (drake_standup/control/controller.py).
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     # Its period: the plant's step (a whole multiple of it; a faster controller
-    # is wasted on a discrete plant). 250 Hz; the authors ran 100 Hz (SPEC 3).
+    # is wasted on a discrete plant). 250 Hz; the authors ran 100 Hz ([authors-code]).
     # At twice the plant step the study found larger errors and no gain. s.
     controller_period_s: float = 0.004
     initial: InitialPose = field(default_factory=InitialPose)

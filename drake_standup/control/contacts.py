@@ -69,8 +69,8 @@ def wrench_cone_matrix(spec: ContactSpec) -> np.ndarray:
 
     The last: a rectangle whose corners each push with a force in the friction pyramid
     can give a yaw moment only as far as its CoP and its tangential force leave it room
-    (Caron, Pham, Nakamura, ICRA 2015, "Stability of surface contacts for humanoid
-    robots", the contact wrench cone's closed form), about the rectangle's centre c and
+    ([caron2015]: Caron, Pham, Nakamura, ICRA 2015, the contact wrench cone's closed
+    form), about the rectangle's centre c and
     with X, Y its half-sizes:
         tau_max =  mu (X + Y) f_z - |Y f_x + mu tau_x| - |X f_y + mu tau_y|
         tau_min = -mu (X + Y) f_z + |Y f_x - mu tau_x| + |X f_y - mu tau_y|

@@ -1,4 +1,5 @@
-"""WholeBodyController: the momentum-based whole-body torque controller (SPEC 2, 3, 7).
+"""WholeBodyController: the momentum-based whole-body torque controller ([nava2016],
+[authors-code], [early-probe]).
 
 A plain object: each tick, from the controller's model at the robot's state (RobotTerms,
 control/model.py), the tick's task references (TaskReferences, control/targets.py) and

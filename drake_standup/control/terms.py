@@ -2,7 +2,7 @@
 
 Everything is in the world frame W unless a name says otherwise. The floating base
 (root_link, body B) comes first in v as [w_WB; v_WBo], both expressed in W (Drake's
-QuaternionFloatingJoint), which gives exact shortcuts (SPEC 5, checked in
+QuaternionFloatingJoint), which gives exact shortcuts ([drake-docs], checked in
 tests/control/test_controller.py):
   - the first six rows of M v are the robot's spatial momentum about Bo,
     [h_WBo; l_W] = M[0:6] v, so the centroidal momentum needs no extra Drake call:

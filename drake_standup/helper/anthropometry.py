@@ -1,7 +1,7 @@
 """A person as a body (issue 32, first part): segments scaled from an anthropometric table
 to a height and a mass, added to a MultibodyPlant.
 
-The table is de Leva (1996), "Adjustments to Zatsiorsky-Seluyanov's segment inertia
+The table is [de-leva1996], de Leva (1996), "Adjustments to Zatsiorsky-Seluyanov's segment inertia
 parameters", J. Biomech. 29(9): 1223-1230, male columns. Table 4 gives each segment's mass
 (fraction of body mass), its centre of mass (fraction of its length from the first
 landmark) and its radii of gyration (fractions of its length: sagittal, transverse,

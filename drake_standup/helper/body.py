@@ -79,7 +79,7 @@ REFERENCE_MASS_KG = 75.0
 # How soon the arms' rest posture gives way to where the robot moves them (helper_control:
 # the set-point's time constant). Soft: a relaxed person yields at the pace of the
 # long-latency stretch reflex (~50-100 ms); stiff: they hold until they react, a simple
-# reaction time (0.15-0.25 s, SPEC 10). A modelling assumption, no measurement. s.
+# reaction time (0.15-0.25 s, [reaction-time]). A modelling assumption, no measurement. s.
 YIELD_TIME_S = {"soft": 0.1, "stiff": 0.2}
 # The robot's hand each of the person's grips holds (facing each other).
 GRIPS = {"l_hand": "right_grip", "r_hand": "left_grip"}

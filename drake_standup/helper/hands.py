@@ -68,7 +68,7 @@ def scripted_forces(pulls: list[Pull], t: float) -> np.ndarray:
 def predicted(sample: np.ndarray, hand: int, lag_s: float) -> tuple[np.ndarray, np.ndarray]:
     """(position, velocity) of hand (0 left, 1 right) a person expects now from a sample
     (PERCEIVED) seen lag_s ago: carried on at the velocity seen. People track a steady
-    motion without their reaction time's lag and lag its changes (SPEC 10); a person
+    motion without their reaction time's lag and lag its changes ([reaction-time]); a person
     without it drags a hand moving at v back by K v lag_s (15 N at 0.5 m/s, 0.2 s)."""
     p, v = sample[3 * hand : 3 * hand + 3], sample[6 + 3 * hand : 9 + 3 * hand]
     return p + lag_s * v, v

@@ -1,4 +1,4 @@
-"""The iCub from icub-models, made Drake-ready, added to a plant; its joint tables.
+"""The iCub from icub-models ([icub-models]), made Drake-ready, added to a plant; its joint tables.
 
 add_icub parses the URDF that urdf.py prepared (STL visuals as OBJ, no collision
 elements, optionally reduced to the ~40 bodies that carry mass or show something) and:
@@ -46,7 +46,7 @@ from drake_standup.robot.urdf import (
     prepare_urdf,
 )
 
-# The motors of the authors' controller model (SPEC 9): gear ratio 100 on every joint;
+# The motors of the authors' controller model ([authors-code]): gear ratio 100 on every joint;
 # rotor inertia 0.0827e-4 kg m^2 on the legs and torso pitch/roll, 0.0585e-4 on torso yaw
 # and the arms. Drake reflects it as ratio^2 x rotor on the joint (0.0827 and 0.0585 kg m^2):
 # diagonal, where the authors' model also couples the shoulder's and torso's tendon-driven

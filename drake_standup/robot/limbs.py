@@ -5,8 +5,8 @@ when judging a whip: a light limb should not outrun the trunk that carries it).
 
 The shoulder of iCub 2.x is driven by tendons whose lengths bound its three joints
 (pitch, roll, yaw) together, A q + b > 0, not by the box of joint limits the URDF (and the
-firmware) declare: icub-tech's documentation, "Range of Motion of the iCub Shoulders"
-(iCub kinematics pages), gives one row per tendon, 14 rows with c = 1.71; they are held
+firmware) declare: icub-tech's documentation ([icub-tech]), "Range of Motion of the iCub
+Shoulders" (iCub kinematics pages), gives one row per tendon, 14 rows with c = 1.71; they are held
 here, in radians (b scaled by pi / 180).
 """
 

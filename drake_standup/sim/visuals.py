@@ -37,7 +37,7 @@ from drake_standup.helper.hands import TASK_FRAMES
 from drake_standup.robot.icub import Robot
 
 PREFIX = "/standup"
-# Arrow length per newton: the largest pull a slider allows (25 N, SPEC 3's
+# Arrow length per newton: the largest pull a slider allows (25 N, [authors-code]'s
 # strongest helper) draws 0.25 m, about the forearm's length. m/N.
 PULL_M_PER_N = 0.01
 # Below this a hand is not pulled and its arrow is hidden. N.

@@ -2,7 +2,7 @@
 
 psi(0) = 0 and, while the human's interaction helps,
     psi_dot = min{ psi_dot_upper, max{ 1, ratio } }
-with (SPEC 2; t = d_psi x_d the path tangent, Omega f the CoM acceleration the
+with ([tirupachuri2019]; t = d_psi x_d the path tangent, Omega f the CoM acceleration the
 measured hand wrenches cause, xdot the measured CoM velocity):
     tangent law (the paper's proposition):   ratio = xdot.t / (|t|^2 + eps)
     interaction law (the authors' code):     ratio = (xdot.Omega f)(t.Omega f)

@@ -7,7 +7,7 @@ tick) leans it against the pull and, in the compliant response, yields it to the
 Each stand-up state k >= 2 moves the CoM along a min-jerk segment
     x_d(psi) = x_start + delta * s(tau),  tau = clamp((psi - psi_entry) / T, 0, 1),
     s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5,
-and time derivatives follow by the chain rule (SPEC 2):
+and time derivatives follow by the chain rule ([tirupachuri2019]):
     xd_dot  = d_psi x_d * psi_dot
     xd_ddot = d2_psi x_d * psi_dot^2 + d_psi x_d * psi_ddot.
 Segments start where the previous one ended (the state machine passes its end

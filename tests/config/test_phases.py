@@ -11,8 +11,8 @@ from drake_standup.config import Scenario, ScenarioError, apply_overrides, parse
 from drake_standup.config.legacy import LEGACY
 from drake_standup.config.phases import PHASES, PhaseTable, posture
 
-# SPEC 3's posture rows (state 2 with the probe's torso pitch 1.0, SPEC 7).
-SPEC_POSTURES = {
+# [authors-code]'s posture rows (state 2 with the probe's torso pitch 1.0, [early-probe]).
+AUTHORS_POSTURES = {
     "forward": [1.5402, 0.1594, -1.7365, -0.2814, -1.6455, 0.4363, 0.5862, 0.2473, 1.0],
     "lift_off": [1.1097, 0.0122, -0.8365, -0.0714, -1.4615, 0.4363, 0.1545, 0.2018, 0.0611],
     "rise": [0.2094, 0.1047, -0.1745, -0.0349, -1.6455, 0.4363, 0.5862, 0.2473, 0.0],
@@ -46,7 +46,7 @@ controller:
 def test_the_defaults_are_the_sources_numbers():
     table = PhaseTable()
     assert [table.phase(k) for k in range(1, 5)] == list(table)
-    # SPEC 3's, but state 3 over 0.7 s, not 0.5 s: its forward acceleration put the CoP
+    # [authors-code]'s, but state 3 over 0.7 s, not 0.5 s: its forward acceleration put the CoP
     # past the soles' pads' middle third (issue 30, phases.py).
     assert [phase.segment_psi for phase in table][1:] == [1.5, 0.7, 1.8]
     assert table.forward.com_delta_m == [0.1277, 0.0, 0.0]
@@ -54,9 +54,9 @@ def test_the_defaults_are_the_sources_numbers():
     assert table.seated.exit.min_time_s == 3.0 and table.seated.exit.asked
     assert table.forward.exit.feet_force_N == 150.0
     assert table.lift_off.exit.each_foot_force_N == 95.0
-    for name, row in SPEC_POSTURES.items():
+    for name, row in AUTHORS_POSTURES.items():
         assert getattr(table, name).posture_rad == posture(row)
-    assert posture(SPEC_POSTURES["rise"])["r_knee"] == -0.1745  # both sides alike
+    assert posture(AUTHORS_POSTURES["rise"])["r_knee"] == -0.1745  # both sides alike
     assert not table.seated.posture_rad  # state 1 holds the posture it starts from
     assert [phase.advances for phase in table] == [False, True, True, True]
     assert [phase.when_hindered for phase in table] == ["wait", "sit_back", "step_back", "stand"]

@@ -356,7 +356,7 @@ def test_the_soles_moment_rate_reads_the_last_tick_from_the_state(scene):
 
 
 def test_com_jacobian_bias_and_momentum_from_the_mass_matrix(scene):
-    """With the floating-base velocities expressed in W (SPEC 5), on random states:
+    """With the floating-base velocities expressed in W ([drake-docs]), on random states:
     M[3:6]/m = J_com, Cv[3:6]/m = Jdot_com v, M[3:6]^T g = tau_g, and the controller's
     CoM (read off M[0:3, 3:6] = m [p_BoCom]x), centroidal momentum and base orientation
     (from the quaternion) equal Drake's CoM, spatial momentum about the CoM and root_link

@@ -191,8 +191,8 @@ def test_a_hindering_pull_waits_seated_and_the_robot_stands_up_once_it_stops():
     ],
 )
 def test_a_hindering_pull_in_any_state_does_not_topple_it(start_s, force_N):
-    """Issues 13 and 21: the authors' opposing person (18 N backwards on each hand, SPEC
-    9), abrupt (0.1 s ramps), for 4 s, started before the stand-up (1.0 s),
+    """Issues 13 and 21: the authors' opposing person (18 N backwards on each hand,
+    [icub-logs]), abrupt (0.1 s ramps), for 4 s, started before the stand-up (1.0 s),
     inside state 2 (3.5 s: it sits back and waits), as state 3 begins (4.5 s) or inside
     it (4.6 s: it goes back onto its thighs in state 2),
     state 4 (5.2 s) or on the standing robot (8.0 s: it leans into the pull within its

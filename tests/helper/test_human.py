@@ -365,7 +365,7 @@ def test_reactive_scenarios_load():
     it (mode: reactive and the first keys only) loads with guide: velocity."""
     shipped = load_scenario(SCENARIO_DIR / "reactive.yaml").human
     assert shipped.mode == "reactive" and shipped.reactive.guide == "path"
-    assert shipped.reactive.force_cap_N <= 25.0  # SPEC 3: 10-25 N per hand
+    assert shipped.reactive.force_cap_N <= 25.0  # [authors-code]: 10-25 N per hand
     old = parse_scenario(
         "human:\n  mode: reactive\n  reactive:\n    force_cap_N: 15.0\n"
         "    target_velocity_mps: [0.1, 0.0, 0.2]\n",

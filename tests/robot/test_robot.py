@@ -417,7 +417,7 @@ def test_seated_pad_rests_on_its_surface(seated, pad):
 
 # --- Motor reflected inertia ---------------------------------------------------------
 
-# The authors' motor model (SPEC 9), written out here: gear ratio 100; rotor inertia
+# The authors' motor model ([authors-code]), written out here: gear ratio 100; rotor inertia
 # 0.0827e-4 kg m^2 on the legs and torso pitch/roll, 0.0585e-4 on torso yaw and the arms.
 _LEGS_TORSO = [
     f"{side}_{joint}"

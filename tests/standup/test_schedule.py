@@ -22,7 +22,7 @@ from drake_standup.standup.transitions import Measurements, _enter, _sit_back, i
 CONFIG = ControllerConfig()
 TABLE = PhaseTable()
 NAN3 = np.full(3, math.nan)
-F_MIN, SEAT_MAX, FOOT_MAX = 10.0, 400.0, 1000.0  # the defaults, N (SPEC 3, 7)
+F_MIN, SEAT_MAX, FOOT_MAX = 10.0, 400.0, 1000.0  # the defaults, N ([authors-code], [early-probe])
 MARGIN = 20.0  # controller.seat_measured_margin_N
 
 

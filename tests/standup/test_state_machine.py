@@ -33,7 +33,7 @@ CFG_TIME = dataclasses.replace(CFG, trigger="time")
 
 
 def _table(**exits) -> PhaseTable:
-    """The default phase table with the authors' dwell times (SPEC 3; our defaults leave
+    """The default phase table with the authors' dwell times ([authors-code]; our defaults leave
     the dwell to psi), so the dwell guards are exercised too; exits: more of it, as
     {phase: {field: value}} (a field of Phase, or exit.<field> of its Guard)."""
     table = PhaseTable()
@@ -111,7 +111,7 @@ def _first_state_2(force_N: float, cfg=CFG, up_N: float = 0.0) -> float:
 
 def test_a_gentle_pull_starts_the_stand_up_once_held_for_a_reaction_time():
     """A firm pull (12 N per hand) starts it within the filter and the dwell (50 + 50 ms);
-    a gentle one (8 N, under 10 N but over SPEC 9's 6.5 N of nobody helping) only once it
+    a gentle one (8 N, under 10 N but over [icub-logs]' 6.5 N of nobody helping) only once it
     has been over 6.5 N, through the filter, for gentle_pull_time_s; 6 N never does."""
     firm, gentle = _first_state_2(12.0), _first_state_2(8.0)
     assert 3.0 < firm <= 3.0 + 0.05 + 3 * CFG.force_filter_time_constant_s

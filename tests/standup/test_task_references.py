@@ -91,7 +91,7 @@ def test_the_schedule_is_the_phase_tables(rig):
             high = limits.position_upper_limits()[0] - margin
             assert not ref.posture_hold[k]
             assert ref.posture_rad[k] == min(max(phase.posture_rad[joint], low), high)
-    # SPEC 3's elbow target 0.2473 rad lies below the URDF's 0.262 limit: clamped.
+    # [authors-code]'s elbow target 0.2473 rad lies below the URDF's 0.262 limit: clamped.
     k = rig["joints"].names.index("l_elbow")
     assert schedule[2].posture_rad[k] > TABLE.forward.posture_rad["l_elbow"]
 

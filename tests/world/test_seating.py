@@ -58,7 +58,7 @@ def test_the_default_chair_is_the_shipped_file():
 
 
 def test_the_solved_pose_on_the_shipped_chair_is_the_authors():
-    """On the shipped chair the solved legs are SPEC 3's seated pose (the feasibility
+    """On the shipped chair the solved legs are [authors-code]'s seated pose (the feasibility
     probe's knee and flat-sole ankle) to 1 mrad, its base to 1 mm."""
     _, scene = _scene()
     for name in ("l_hip_pitch", "l_knee", "l_ankle_pitch", "r_hip_pitch", "r_knee"):
@@ -154,7 +154,7 @@ def test_a_chair_it_cannot_sit_on_is_one_error_line(tmp_path, setting, message):
 def test_the_forward_target_follows_the_feet(height):
     """The plan ends state 2's CoM segment where the table says about the seated soles
     (the soles' frames by forward kinematics), on every seat; on the shipped one that is
-    SPEC 3's 0.1277 m in front of where the CoM sits, to 0.5 mm."""
+    [authors-code]'s 0.1277 m in front of where the CoM sits, to 0.5 mm."""
     from drake_standup.standup.plan import feet_reach, make_plan
     from drake_standup.world.station import make_station
 
@@ -174,8 +174,8 @@ def test_the_forward_target_follows_the_feet(height):
 def test_the_lift_off_postures_move_with_the_seated_pose():
     """resolve_postures shifts the flagged phases' joints by the seat's shift and keeps
     them inside the limits; others as given. On a 0.18 m seat the plan's state-2 knee is
-    the seated knee (SPEC 3's state 2 keeps the knees as they sit), on the shipped seat
-    SPEC 3's numbers to 1 mrad."""
+    the seated knee ([authors-code]'s state 2 keeps the knees as they sit), on the shipped seat
+    [authors-code]'s numbers to 1 mrad."""
     from drake_standup.config.phases import PhaseTable, resolve_postures
     from drake_standup.standup.plan import feet_reach, make_plan
     from drake_standup.world.station import make_station

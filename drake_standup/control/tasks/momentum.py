@@ -1,5 +1,5 @@
 """The momentum task and its law: the rate of change of the centroidal momentum the
-contacts must give (Nava et al., IROS 2016; SPEC 2), L = [L_ang about the CoM; m xdot]:
+contacts must give (Nava et al., IROS 2016: [nava2016]), L = [L_ang about the CoM; m xdot]:
 
     xddot* = xd_ddot - K_D (xdot - xd_dot) - K_P (x - x_d)
     Ldot*  = [-K_D,ang L_ang - K_P,ang int L_ang;  m xddot* + f_par  (+ m K_I int e_z)]
