@@ -103,7 +103,7 @@ class Phase:
     com_x_over_soles_m: float | None = None
     com_height_m: float | None = None
     # Without com_height_m: end at the erect CoM height of this phase's posture on the
-    # scenario's robot (scene.erect_com_height_m, resolved by resolve_com_heights), so
+    # scenario's robot (scene.standing, resolved by resolve_com_heights), so
     # that each model stands at its own height.
     com_height_erect: bool = False
     start_at_com_height: bool = False
@@ -216,7 +216,7 @@ class PhaseTable:
             exit=Guard(unloaded=True, each_foot_force_N=95.0),
         )
     )
-    # 4: up to the erect CoM height (scene.erect_com_height_m of this posture: 0.5753 m
+    # 4: up to the erect CoM height (scene.standing of this posture: 0.5753 m
     # on iCubGazeboV2_5, 0.553 m on iCubGenova01), the legs' posture ending the rise; the
     # final state.
     rise: Phase = field(

@@ -60,7 +60,7 @@ def standup_metrics(
     sample: the CoM within height_tolerance_m of the standing height, and every pad group
     but the soles (thighs, buttocks) carrying less than unloaded_N in all. The standing
     height is standing_height_m, the erect height (simulate.py: the CoM height of the
-    state-4 posture, scene.erect_com_height_m); without it, the run's own: the CoM
+    state-4 posture, scene.standing); without it, the run's own: the CoM
     reference's height at the end of the run, once its last segment (state 4) has run
     through (None otherwise: the run never set it). Where the controller leans the CoM
     against a pull (signals com_lean_W, a horizontal shift d), the standing height is
@@ -320,7 +320,7 @@ def run_metrics(
     """metrics.json's entries of a run from its signals: the seated balance and the final
     contact forces, the robot's mass (the model's, and the simulated one with
     perturbation.mass_scale), and with the stand-up controller (psi_final given) the
-    advancement, the stand-up against the erect height (scene.erect_com_height_m of the
+    advancement, the stand-up against the erect height (scene.standing of the
     rise's posture) and the controller's QP, joint-limit, mass-estimate and waiting
     figures; the peak joint torque."""
     plant, instance = station.plant, station.robot.model_instance

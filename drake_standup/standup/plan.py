@@ -19,7 +19,7 @@ from drake_standup.config.phases import (
     resolve_com_x,
     resolve_postures,
 )
-from drake_standup.world.scene import Scene, erect_com_height_m
+from drake_standup.world.scene import Scene
 from drake_standup.world.seating import JOINT_MARGIN_RAD, LEG_JOINTS
 from drake_standup.world.sensing import FeetReach
 from drake_standup.world.station import Station
@@ -60,10 +60,6 @@ def feet_reach(config: ControllerConfig) -> FeetReach:
     )
 
 
-def _posture_key(posture_rad: dict[str, float]) -> tuple:
-    return tuple(sorted(posture_rad.items()))
-
-
 def seated_shift(scene: Scene) -> tuple[dict[str, float], dict[str, tuple[float, float]]]:
     """(how far the robot's seated leg joints (seating.LEG_JOINTS, both sides) are from
     the shipped seated pose's, and those joints' limits), rad, by joint name."""
@@ -84,18 +80,15 @@ def make_plan(scenario: Scenario, station: Station) -> StandupPlan:
     """The plan for scenario's robot in the station's scene: the forward ends from where the
     soles are seated (resolve_com_x); the lift-off's postures from the seated pose
     (resolve_postures); each standing posture's CoM height from forward kinematics
-    (scene.erect_com_height_m), once per distinct posture; the rise's is the station's
-    own where it stands erect (its standing support)."""
+    (scene.standing, which works each posture out once per build); the rise's is the
+    station's own where it stands erect (its standing support)."""
     rise = scenario.phases.rise
-    heights: dict[tuple, float] = {}
-    if rise.com_height_m is None:
-        heights[_posture_key(rise.posture_rad)] = station.standing.com_height_m
+    standing = station.scene.standing
 
     def erect(posture_rad: dict[str, float]) -> float:
-        key = _posture_key(posture_rad)
-        if key not in heights:
-            heights[key] = erect_com_height_m(station.scene, scenario, posture_rad)
-        return heights[key]
+        if rise.com_height_m is None and posture_rad == rise.posture_rad:
+            return station.standing.com_height_m
+        return standing.erect_com_height_m(posture_rad)
 
     seated = station.scene.seated
     soles_x = scenario.chair.seat_edge_x_m() + seated.feet_ahead_of_seat_edge_m

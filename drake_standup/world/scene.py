@@ -1,5 +1,8 @@
 """The world of the stand-up: a discrete MultibodyPlant with the iCub, a chair
-and a floor, hydroelastic contact, and the robot's seated initial state."""
+and a floor, hydroelastic contact, and the robot's seated initial state; and the
+scene's derived standing numbers (StandingGeometry: the CoM's erect height, the hands'
+and soles' offsets from the CoM in a standing posture), each posture's worked out once
+per build, which the station, the sensing and the plan all read (scene.standing)."""
 
 from __future__ import annotations
 
@@ -48,6 +51,79 @@ class Scene:
     # With a helper's body: the same scene without it (the robot's own model, for the
     # controller: it needs every other model welded), else None.
     alone: Scene | None = None
+    # The robot standing in a posture, each posture's numbers worked out once (add_scene).
+    standing: StandingGeometry | None = None
+
+
+@dataclass(frozen=True)
+class StandingPose:
+    """The robot standing in one posture, its soles flat at the height they rest at when
+    seated, upright at the seated yaw (world axes, m)."""
+
+    com_height_m: float  # the CoM above the floor
+    hands_from_com_m: np.ndarray  # (2, 3) the hands' origins from the CoM, left, right
+    soles_from_com_m: np.ndarray  # (2, 3) the soles' origins from the CoM
+
+
+class StandingGeometry:
+    """The scene's standing numbers: one forward-kinematics pass per distinct posture, in
+    one context of its own, kept for every later question of the build (the station's
+    checks and standing support, the sensing, the plan's CoM heights). passes counts them.
+
+    A posture names some joints; the others stay as seated (the arms of a braced posture).
+    With the sagittal leg angles summing to zero (hip pitch + knee + ankle pitch, as in the
+    authors' state-4 posture) the soles are flat on the floor (checked by the tests)."""
+
+    def __init__(self, scene: Scene, yaw_rad: float):
+        self._scene, self._yaw = scene, yaw_rad
+        self._poses: dict[tuple, StandingPose] = {}
+        self._context = None
+        self._sole_z_seated = 0.0
+        self.passes = 0
+
+    def pose(self, posture_rad: dict[str, float]) -> StandingPose:
+        key = tuple(sorted(posture_rad.items()))
+        if key not in self._poses:
+            self._poses[key] = self._solve(posture_rad)
+        return self._poses[key]
+
+    def erect_com_height_m(self, posture_rad: dict[str, float]) -> float:
+        return self.pose(posture_rad).com_height_m
+
+    def straight_com_height_m(self, posture_rad: dict[str, float]) -> float:
+        """The highest the CoM stands with the soles flat: posture_rad with the legs and
+        the torso straight (their joints at 0), the arms as posture_rad has them."""
+        instance = self._scene.robot.model_instance
+        plant = self._scene.plant
+        straight = {n: 0.0 for n in _STRAIGHT if plant.HasJointNamed(n, instance)}
+        return self.erect_com_height_m({**posture_rad, **straight})
+
+    def _solve(self, posture_rad: dict[str, float]) -> StandingPose:
+        scene, plant = self._scene, self._scene.plant
+        instance = scene.robot.model_instance
+        soles = [scene.robot.frame(plant, name) for name in ("l_sole", "r_sole")]
+        hands = [scene.robot.frame(plant, name) for name in ("l_hand", "r_hand")]
+        if self._context is None:
+            self._context = plant.CreateDefaultContext()
+            set_seated_state(scene, self._context)
+            self._sole_z_seated = min(
+                f.CalcPoseInWorld(self._context).translation()[2] for f in soles
+            )
+        context = self._context
+        self.passes += 1
+        set_joint_positions(plant, context, instance, scene.seated.joints_rad)
+        set_joint_positions(plant, context, instance, posture_rad)
+        root = plant.GetBodyByName("root_link", instance)
+        upright = RigidTransform(RollPitchYaw(0.0, 0.0, self._yaw), [0.0, 0.0, 1.0])
+        plant.SetFreeBodyPose(context, root, upright)
+        com = plant.CalcCenterOfMassPositionInWorld(context, [instance])
+        sole_p = np.array([f.CalcPoseInWorld(context).translation() for f in soles])
+        hand_p = np.array([f.CalcPoseInWorld(context).translation() for f in hands])
+        return StandingPose(
+            com_height_m=float(com[2] - sole_p[:, 2].min() + self._sole_z_seated),
+            hands_from_com_m=hand_p - com,
+            soles_from_com_m=sole_p - com,
+        )
 
 
 def add_scene(
@@ -100,7 +176,9 @@ def add_scene(
     scene_graph.collision_filter_manager().Apply(
         CollisionFilterDeclaration().ExcludeWithin(robot_geometries)
     )
-    return Scene(plant, scene_graph, robot, seated, helper, alone)
+    scene = Scene(plant, scene_graph, robot, seated, helper, alone)
+    scene.standing = StandingGeometry(scene, scenario.initial.base_rpy_rad[2])
+    return scene
 
 
 def without_body(scenario: Scenario) -> Scenario:
@@ -138,36 +216,8 @@ def set_seated_state(scene: Scene, plant_context: Context) -> None:
         plant.SetVelocities(plant_context, person, np.zeros(plant.num_velocities(person)))
 
 
-def _standing_context(scene: Scene, scenario: Scenario, posture_rad: dict[str, float]):
-    """A plant context of the robot in a standing posture: the joints named in
-    posture_rad at their values (the others as seated), the base upright at the seated
-    yaw, 1 m up; and the soles' heights when seated."""
-    plant = scene.plant
-    instance = scene.robot.model_instance
-    context = plant.CreateDefaultContext()
-    set_seated_state(scene, context)
-    soles = [scene.robot.frame(plant, name) for name in ("l_sole", "r_sole")]
-    sole_z_seated = [frame.CalcPoseInWorld(context).translation()[2] for frame in soles]
-    set_joint_positions(plant, context, instance, posture_rad)
-    root = plant.GetBodyByName("root_link", instance)
-    yaw = scenario.initial.base_rpy_rad[2]
-    plant.SetFreeBodyPose(context, root, RigidTransform(RollPitchYaw(0.0, 0.0, yaw), [0, 0, 1]))
-    return context, soles, sole_z_seated
-
-
-def erect_com_height_m(scene: Scene, scenario: Scenario, posture_rad: dict[str, float]) -> float:
-    """The CoM's height above the floor in a standing posture (_standing_context), the
-    soles at the height they rest at on the floor when seated. With the sagittal
-    leg angles summing to zero (hip pitch + knee + ankle pitch, as in the authors' state-4
-    posture) the soles are then flat on the floor (checked by the caller's tests)."""
-    plant = scene.plant
-    context, soles, sole_z_seated = _standing_context(scene, scenario, posture_rad)
-    sole_z = [frame.CalcPoseInWorld(context).translation()[2] for frame in soles]
-    com_z = plant.CalcCenterOfMassPositionInWorld(context, [scene.robot.model_instance])[2]
-    return float(com_z - min(sole_z) + min(sole_z_seated))
-
-
-# The joints standing_com_height_m straightens (those the model has): legs and torso.
+# The joints StandingGeometry.straight_com_height_m straightens (those the model has):
+# legs and torso.
 _STRAIGHT = [f"{s}_{j}" for s in "lr" for j in ("hip_pitch", "hip_roll", "hip_yaw", "knee")]
 _STRAIGHT += [f"{s}_{j}" for s in "lr" for j in ("ankle_pitch", "ankle_roll")]
 _STRAIGHT += ["torso_pitch", "torso_roll", "torso_yaw"]
@@ -176,28 +226,17 @@ _STRAIGHT += ["torso_pitch", "torso_roll", "torso_yaw"]
 COM_HEIGHT_MARGIN_M = 0.02
 
 
-def standing_straight_com_height_m(
-    scene: Scene, scenario: Scenario, posture_rad: dict[str, float]
-) -> float:
-    """The highest the CoM stands with the soles flat on the floor: erect_com_height_m of
-    posture_rad with the legs and the torso straight (their joints at 0), the arms as
-    posture_rad has them."""
-    instance = scene.robot.model_instance
-    straight = {n: 0.0 for n in _STRAIGHT if scene.plant.HasJointNamed(n, instance)}
-    return erect_com_height_m(scene, scenario, {**posture_rad, **straight})
-
-
 def check_com_heights(scene: Scene, scenario: Scenario) -> None:
     """Each phase's com_height_m within the robot's reach: at most its CoM standing
-    straight (standing_straight_com_height_m of the phase's posture) + COM_HEIGHT_MARGIN_M;
-    raises ScenarioError (one line). config.validate, which builds no plant, has checked
-    that it is > 0."""
+    straight (scene.standing.straight_com_height_m of the phase's posture) +
+    COM_HEIGHT_MARGIN_M; raises ScenarioError (one line). config.validate, which builds
+    no plant, has checked that it is > 0."""
     model = scenario.robot.model
     for name in PHASES:
         phase = getattr(scenario.phases, name)
         if phase.com_height_m is None:
             continue
-        straight = standing_straight_com_height_m(scene, scenario, phase.posture_rad)
+        straight = scene.standing.straight_com_height_m(phase.posture_rad)
         top = round(straight + COM_HEIGHT_MARGIN_M, 3)
         if not 0.0 < phase.com_height_m <= top:
             raise ScenarioError(
@@ -205,19 +244,3 @@ def check_com_heights(scene: Scene, scenario: Scenario) -> None:
                 f"and <= {top} (m: {model}'s CoM standing straight, {straight:.3f}, "
                 f"+ {COM_HEIGHT_MARGIN_M})"
             )
-
-
-def standing_offsets_m(
-    scene: Scene, scenario: Scenario, posture_rad: dict[str, float]
-) -> tuple[np.ndarray, np.ndarray]:
-    """In a standing posture (_standing_context): the hands' origins from the CoM (2 x 3,
-    left, right) and the soles' origins from it (2 x 3), world axes, m."""
-    plant = scene.plant
-    context, soles, _ = _standing_context(scene, scenario, posture_rad)
-    com = plant.CalcCenterOfMassPositionInWorld(context, [scene.robot.model_instance])
-
-    def offsets(names):
-        frames = [scene.robot.frame(plant, name) for name in names]
-        return np.array([f.CalcPoseInWorld(context).translation() - com for f in frames])
-
-    return offsets(("l_hand", "r_hand")), offsets(("l_sole", "r_sole"))

@@ -55,8 +55,8 @@ class FeetReach:
 @dataclass(frozen=True)
 class StandingSupport:
     """What the standing robot can hold, for standing_pull_usage: its erect CoM height,
-    its hands' and soles' origins from the CoM (2 x 3 each, left and right; scene.
-    standing_offsets_m), how far the stand-up leans its CoM (forward, back, sideways)
+    its hands' and soles' origins from the CoM (2 x 3 each, left and right;
+    scene.StandingPose), how far the stand-up leans its CoM (forward, back, sideways)
     and each sole's CoP box (FeetReach), m."""
 
     com_height_m: float

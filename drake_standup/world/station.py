@@ -40,13 +40,7 @@ from drake_standup.ports.payloads import HAND_WRENCHES
 from drake_standup.robot.icub import ActuatedJoints, Robot, actuated_joints, arm_joint_names
 from drake_standup.world.pad_forces import ContactForceReporter
 from drake_standup.world.perturbations import NoisyWrenchSensor, PushSource
-from drake_standup.world.scene import (
-    Scene,
-    add_scene,
-    check_com_heights,
-    erect_com_height_m,
-    standing_offsets_m,
-)
+from drake_standup.world.scene import Scene, add_scene, check_com_heights
 from drake_standup.world.sensing import (
     FeetReach,
     RobotSensing,
@@ -111,7 +105,7 @@ def make_station(
     measured = _add_pushes_and_hand_sensors(builder, scenario, plant, robot)
     arms = arm_joint_names(plant, robot)
     (standing, braced), robot_state = _add_sensing(builder, scene, scenario, feet, measured, arms)
-    drop = erect_com_height_m(scene, scenario, scenario.phases.rise.posture_rad) - (
+    drop = scene.standing.erect_com_height_m(scenario.phases.rise.posture_rad) - (
         braced.com_height_m
     )
 
@@ -203,7 +197,7 @@ def _add_pushes_and_hand_sensors(
 
 def braced_posture(posture_rad: dict[str, float], arm_joints: list[str]) -> dict[str, float]:
     """posture_rad with the arms braced: their joints (arm_joint_names) left out, so they
-    stay as the robot sat (scene._standing_context, the controller's posture hold)."""
+    stay as the robot sat (scene.StandingGeometry, the controller's posture hold)."""
     return {name: value for name, value in posture_rad.items() if name not in arm_joints}
 
 
@@ -222,11 +216,11 @@ def _add_sensing(
     rise = scenario.phases.rise
 
     def support(posture: dict[str, float], height_m: float | None) -> StandingSupport:
-        hands, soles = standing_offsets_m(scene, scenario, posture)
+        pose = scene.standing.pose(posture)
         return StandingSupport(
-            com_height_m=height_m or erect_com_height_m(scene, scenario, posture),
-            hands_m=hands,
-            soles_m=soles,
+            com_height_m=height_m or pose.com_height_m,
+            hands_m=pose.hands_from_com_m,
+            soles_m=pose.soles_from_com_m,
             lean_m=feet.lean_m,
             cop_x_m=feet.cop_x_m,
             cop_y_m=feet.cop_y_m,

@@ -193,19 +193,17 @@ def test_every_older_key_is_in_the_older_file_here():
 )
 def test_each_robot_rises_to_its_own_erect_height(model, height_m):
     """The rise ends, by default, at the erect CoM height of its posture on the robot at
-    hand (scene.erect_com_height_m, resolved when the stand-up controller is made): the
+    hand (scene.standing, resolved when the stand-up controller is made): the
     Gazebo model and a shorter-legged real one differ by 2 cm; a height set in the file
     stays as it is."""
     from pydrake.systems.framework import DiagramBuilder
 
     from drake_standup.config.phases import resolve_com_heights
-    from drake_standup.world.scene import add_scene, erect_com_height_m
+    from drake_standup.world.scene import add_scene
 
     scenario = apply_overrides(Scenario(), [("robot.model", model)])
     scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
-    table = resolve_com_heights(
-        scenario.phases, lambda posture: erect_com_height_m(scene, scenario, posture)
-    )
+    table = resolve_com_heights(scenario.phases, scene.standing.erect_com_height_m)
     assert Scenario().phases.rise.com_height_m is None and table.unresolved_heights() == []
     assert table.rise.com_height_m == pytest.approx(height_m, abs=5e-4)
     assert scenario.phases.rise.com_height_m is None  # the scenario itself is not changed

@@ -10,7 +10,6 @@ from drake_standup.config import SCENARIO_DIR, load_scenario
 from drake_standup.outputs.signals import load_signals
 from drake_standup.sim.diagram import build_diagram
 from drake_standup.sim.simulate import simulate
-from drake_standup.world.scene import erect_com_height_m
 
 pytestmark = pytest.mark.slow
 
@@ -273,7 +272,7 @@ RUNS = ("assisted_run", "unassisted_run", "reactive")
 def test_it_ends_standing_erect(run, request):
     """Issue 12: both knees within 0.35 rad of straight and the CoM at least 0.55 m up at
     the end (read off signals.npz), and the CoM where forward kinematics puts it for the
-    final joint angles with the soles flat (scene.erect_com_height_m): the simulated
+    final joint angles with the soles flat (scene.standing): the simulated
     robot stands on flat feet, not tilted onto an edge."""
     scenario, m, sig = request.getfixturevalue(run)
     names = list(sig["joint_names"])
@@ -284,7 +283,7 @@ def test_it_ends_standing_erect(run, request):
     built = build_diagram(scenario)
     final = dict(zip(names, q, strict=True))
     assert sig["com_W"][-1, 2] == pytest.approx(
-        erect_com_height_m(built.station.scene, scenario, final), abs=0.005
+        built.station.scene.standing.erect_com_height_m(final), abs=0.005
     )
 
 

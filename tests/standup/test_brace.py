@@ -19,7 +19,7 @@ from drake_standup.outputs.metrics import standup_metrics
 from drake_standup.robot.icub import arm_joint_names
 from drake_standup.standup.guards import GuardSignals, Measurements, update_guards
 from drake_standup.standup.task_references import PhaseReferences
-from drake_standup.world.scene import add_scene, erect_com_height_m, set_seated_state
+from drake_standup.world.scene import add_scene, set_seated_state
 from drake_standup.world.station import braced_posture
 
 CFG = StandupConfig()
@@ -72,7 +72,7 @@ def test_braced_the_hands_stand_lower_and_the_com_too():
     braced = braced_posture(rise, arm_joint_names(scene.plant, scene.robot))
     assert set(braced) < set(rise)
     assert all(braced[k] == rise[k] for k in braced)
-    drop = erect_com_height_m(scene, scenario, rise) - erect_com_height_m(scene, scenario, braced)
+    drop = scene.standing.erect_com_height_m(rise) - scene.standing.erect_com_height_m(braced)
     assert 0.005 < drop < 0.05
 
 

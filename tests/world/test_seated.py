@@ -109,7 +109,7 @@ def test_the_default_standing_height_is_the_erect_posture():
     from pydrake.systems.framework import DiagramBuilder
 
     from drake_standup.config import Scenario
-    from drake_standup.world.scene import add_scene, erect_com_height_m
+    from drake_standup.world.scene import add_scene
 
     scenario = Scenario()
     scene = add_scene(DiagramBuilder(), scenario, pd_gains=None, visuals=False)
@@ -117,9 +117,9 @@ def test_the_default_standing_height_is_the_erect_posture():
     for side in "lr":
         legs = [posture[f"{side}_{joint}"] for joint in ("hip_pitch", "knee", "ankle_pitch")]
         assert abs(sum(legs)) < 1e-9
-    height = erect_com_height_m(scene, scenario, posture)
+    height = scene.standing.erect_com_height_m(posture)
     assert scenario.phases.rise.com_height_erect and scenario.phases.rise.com_height_m is None
     assert height == pytest.approx(0.575, abs=1e-3)
     # Straighter knees stand higher; a crouch lower (monotone in the knee).
     straighter = dict(posture, l_knee=-0.05, r_knee=-0.05, l_hip_pitch=0.05, r_hip_pitch=0.05)
-    assert erect_com_height_m(scene, scenario, straighter) > height
+    assert scene.standing.erect_com_height_m(straighter) > height
