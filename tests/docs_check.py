@@ -332,3 +332,35 @@ def outside_citations(path: Path, text: str | None = None) -> list[str]:
     ../shared/): a reader cannot follow them."""
     text = prose(path) if text is None else text
     return re.findall(r"\bSPEC(?:\s+section)?\s+\d+|\.\./shared/\S*", text)
+
+
+def scenario_block(document: Path, section: str) -> str:
+    """The first ```yaml block after a document's section heading."""
+    text = document.read_text()
+    return text[text.index(section) :].split("```yaml\n", 1)[1].split("```", 1)[0]
+
+
+def not_defaults(block: str, defaults) -> list[str]:
+    """The block's values that are not the defaults' (a Scenario): key path, the block's
+    value, the default. Entries of a list (pulls, pushes) are examples and not compared."""
+    import dataclasses
+
+    import yaml
+
+    found = []
+
+    def walk(node, default, path: str) -> None:
+        if isinstance(node, dict):
+            for key, value in node.items():
+                sub = default.get(key) if isinstance(default, dict) else getattr(default, key)
+                walk(value, sub, f"{path}.{key}" if path else key)
+        elif isinstance(node, list) and any(isinstance(v, dict) for v in node):
+            return
+        else:
+            value = list(default) if isinstance(default, tuple) else default
+            assert not dataclasses.is_dataclass(value), path
+            if node != value:
+                found.append(f"{path}: {node!r}, default {value!r}")
+
+    walk(yaml.safe_load(block), defaults, "")
+    return found

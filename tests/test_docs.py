@@ -96,6 +96,17 @@ def test_the_references_are_cited():
     assert keys - cited == set()
 
 
+def test_the_scenario_block_the_docs_call_defaults_is_the_defaults():
+    """docs/outputs.md's public keys "with their defaults" are Scenario()'s."""
+    from drake_standup.config import Scenario
+
+    block = docs_check.scenario_block(docs_check.OUTPUTS_MD, "## Scenario files")
+    assert docs_check.not_defaults(block, Scenario()) == []
+    assert docs_check.not_defaults("duration_s: 15.0\n", Scenario()) == [
+        "duration_s: 15.0, default 5.0"
+    ]
+
+
 def test_the_checks_find_a_name_broken_on_purpose(tmp_path):
     """Each check above, on a copy of a true text with one name broken."""
     design = REPO / "docs" / "design.md"
