@@ -6,8 +6,9 @@ time); this section says who they are and how they hold the robot's hands.
 
 from dataclasses import dataclass
 
-# human.body.tone's settings: a relaxed arm, or one stiffened by co-contraction.
-TONES = ("soft", "stiff")
+# human.body.tone's settings: a relaxed arm, or one made firm by co-contraction. (Older
+# files' soft and stiff still load as relaxed and firm: config/legacy.py.)
+TONES = ("relaxed", "firm")
 
 
 @dataclass
@@ -16,12 +17,12 @@ class BodyHelperConfig:
     # (de Leva 1996, male; helper/anthropometry.py). m, kg.
     height_m: float = 1.75
     mass_kg: float = 75.0
-    # soft (the default): a relaxed arm (Shadmehr & Mussa-Ivaldi 1994), the trunk at
-    # 20 % effort (Gardner-Morse & Stokes 2001); stiff: the arms co-contracted, 3 times
+    # relaxed (the default): a relaxed arm (Shadmehr & Mussa-Ivaldi 1994), the trunk at
+    # 20 % effort (Gardner-Morse & Stokes 2001); firm: the arms co-contracted, 3 times
     # stiffer, the trunk at 40 % effort; also how soon they give way (world/
-    # helper/body.py, JOINT_IMPEDANCE, YIELD_TIME_S). A stiff person reaches their back's
+    # helper/body.py, JOINT_IMPEDANCE, YIELD_TIME_S). A firm person reaches their back's
     # strength and pulls up to 170 N at moments (docs/design.md).
-    tone: str = "soft"
+    tone: str = "relaxed"
     # Hand in hand, the grip's translational spring and damper (a force element between
     # the person's grip and the robot's hand frame; no torque: a hand-hold transmits a
     # force). A fingertip is ~50 N/m at its lightest touch and stiffens with force

@@ -92,10 +92,37 @@ LEGACY = {
 }
 
 
+# Older values of a key, renamed so that one word means one thing (issue 47: a person's
+# tone was soft or stiff, beside the robot's response stiff).
+LEGACY_VALUES = {("human", "body", "tone"): {"soft": "relaxed", "stiff": "firm"}}
+
+
+def _renamed_values(raw: dict) -> dict:
+    """raw with each older value of LEGACY_VALUES under its new name (raw not changed)."""
+    for path, names in LEGACY_VALUES.items():
+        node = raw
+        for key in path[:-1]:
+            node = node.get(key) if isinstance(node, dict) else None
+        value = node.get(path[-1]) if isinstance(node, dict) else None
+        if isinstance(value, str) and value in names:
+            raw = _with(raw, path, names[value])
+    return raw
+
+
+def _with(raw: dict, path: tuple[str, ...], value) -> dict:
+    """A copy of raw along path with path's leaf set to value."""
+    head, *rest = path
+    copy = dict(raw)
+    copy[head] = _with(raw[head], tuple(rest), value) if rest else value
+    return copy
+
+
 def read_legacy(raw: dict) -> dict:
     """raw (one YAML layer, plain data) with every older key moved into its phases:
-    section; raw itself is not changed. Raises ScenarioError for an older key whose value
-    is not of its kind, or that the layer also sets under its phase-table name."""
+    section and every older value renamed (LEGACY_VALUES); raw itself is not changed.
+    Raises ScenarioError for an older key whose value is not of its kind, or that the
+    layer also sets under its phase-table name."""
+    raw = _renamed_values(raw)
     found = [
         (key, raw[section][name])
         for key in LEGACY

@@ -73,14 +73,14 @@ JOINT_IMPEDANCE = {
         **{joint: (k * scale, b * math.sqrt(scale)) for joint, (k, b) in _ARM.items()},
         "lumbar": (k_trunk, 2 * 0.5 * math.sqrt(k_trunk * _TRUNK_MOMENT_KG_M2)),
     }
-    for tone, scale, k_trunk in (("soft", 1.0, 14500.0 * 0.09), ("stiff", 3.0, 19800.0 * 0.09))
+    for tone, scale, k_trunk in (("relaxed", 1.0, 14500.0 * 0.09), ("firm", 3.0, 19800.0 * 0.09))
 }
 REFERENCE_MASS_KG = 75.0
 # How soon the arms' rest posture gives way to where the robot moves them (helper_control:
 # the set-point's time constant). Soft: a relaxed person yields at the pace of the
 # long-latency stretch reflex (~50-100 ms); stiff: they hold until they react, a simple
 # reaction time (0.15-0.25 s, [reaction-time]). A modelling assumption, no measurement. s.
-YIELD_TIME_S = {"soft": 0.1, "stiff": 0.2}
+YIELD_TIME_S = {"relaxed": 0.1, "firm": 0.2}
 # The robot's hand each of the person's grips holds (facing each other).
 GRIPS = {"l_hand": "right_grip", "r_hand": "left_grip"}
 # At t = 0 the robot's hands lie within this fraction of the person's arm (elbows bent).

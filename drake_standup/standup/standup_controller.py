@@ -45,7 +45,7 @@ from drake_standup.standup.com_path import CoMReferenceGenerator
 from drake_standup.standup.contact_schedule import ContactSchedule
 from drake_standup.standup.plan import StandupPlan
 from drake_standup.standup.state_machine import StandupStateMachine
-from drake_standup.standup.task_references import PhaseReferences, ReferenceGenerator
+from drake_standup.standup.task_references import PhaseReferences, TaskReferenceGenerator
 from drake_standup.standup.whole_body import StandupWholeBodyController
 from drake_standup.world.sensing import standing_lean
 from drake_standup.world.station import Station
@@ -123,7 +123,7 @@ def make_standup_controller(
     g = -plant.gravity_field().gravity_vector()[2]
     specs = contact_specs(plant, robot, config, scenario.chair)
     joints = ControllerJoints.of(plant, robot)
-    schedule = PhaseReferences(
+    phases = PhaseReferences(
         table,
         config,
         joints.names,
@@ -144,9 +144,9 @@ def make_standup_controller(
         "controller": StandupWholeBodyController(
             ContactSchedule(config, table),
             model,
-            ReferenceGenerator(
+            TaskReferenceGenerator(
                 config,
-                schedule,
+                phases,
                 as_slice(joints.q_indices),
                 period_s,
                 g,

@@ -12,7 +12,7 @@ table, config/phases.py, with ControllerConfig's defaults):
 with K_D = 2 zeta sqrt(K_P); joints a table does not name hold the first tick's posture;
 targets lie posture_limit_margin_rad inside the joint limits.
 
-ReferenceGenerator makes one tick's TaskReferences in the order the paper's objective
+TaskReferenceGenerator makes one tick's TaskReferences in the order the paper's objective
 reads, each law where its task is:
 
     the CoM target     x_d(psi) leaned against the pull, yielded by the compliant
@@ -130,7 +130,7 @@ class PhaseReferences:
         return self._by_state[key if isinstance(key, tuple) else (key, False)]
 
 
-class ReferenceGenerator:
+class TaskReferenceGenerator:
     """The module docstring's references for each tick: the CoM target chain, then each
     task's law, from the phase's references and the state the tick keeps (momentum and
     height integrals, posture filter, lean, admittance)."""
@@ -138,7 +138,7 @@ class ReferenceGenerator:
     def __init__(
         self,
         config: ControllerConfig,
-        schedule: PhaseReferences,
+        phases: PhaseReferences,
         q_joints: slice | np.ndarray,
         period_s: float,
         gravity_mps2: float = 0.0,
@@ -147,16 +147,16 @@ class ReferenceGenerator:
         standing_need: Callable | None = None,
         usage_limit: float = 1.0,
     ):
-        """q_joints: the actuated joints' entries of q, in the schedule's order;
+        """q_joints: the actuated joints' entries of q, in the phase references' order;
         gravity_mps2: g, the plant's. The robot's weight is that of the model the terms
         are computed with (terms.mass_kg g: the controller's estimate once it has
         weighed the robot), for the lean against the pull and the height integral's
         bound. compliance, standing_need, usage_limit: the CoM target's (com_path.py:
         CoMTarget)."""
         self._config = config
-        self.schedule = schedule
+        self.phases = phases
         self._q_joints = q_joints
-        self._nu = len(schedule.q_target_min)
+        self._nu = len(phases.q_target_min)
         self._period_s = period_s
         self._latched = np.ones(1)  # the posture state's latched flag
         self.com_target = CoMTarget(
@@ -203,8 +203,8 @@ class ReferenceGenerator:
             q_stage if two_stages else q_reference,
             state.posture_hold,
             state.posture_rad,
-            self.schedule.q_target_min,
-            self.schedule.q_target_max,
+            self.phases.q_target_min,
+            self.phases.q_target_max,
             blend=blend,
         )
         q_next = q_reference + blend * (q_stage - q_reference) if two_stages else q_stage_next
@@ -216,7 +216,7 @@ class ReferenceGenerator:
         the last tick left."""
         standup_state, F_hand_W, response = now.standup_state, now.F_hand_W, now.response
         psi_dot, compliance = now.psi_dot, carried.compliance
-        state = self.schedule[standup_state, now.braced]
+        state = self.phases[standup_state, now.braced]
         tau_hand = None if F_hand_W is None else terms.J_W.reshape(len(F_hand_W), -1).T @ F_hand_W
         com_target, lean, next_compliance = self.com_target.target(
             terms,

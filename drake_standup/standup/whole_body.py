@@ -40,7 +40,7 @@ from drake_standup.control.controller import (
 from drake_standup.control.model import ControllerModel
 from drake_standup.ports.payloads import COM_REFERENCE, HAND_WRENCHES
 from drake_standup.standup.contact_schedule import ContactSchedule
-from drake_standup.standup.task_references import CarriedState, ReferenceGenerator, TickInputs
+from drake_standup.standup.task_references import CarriedState, TaskReferenceGenerator, TickInputs
 from drake_standup.standup.transitions import StandupMode
 
 _COMMANDED = DIAGNOSTICS["commanded_normal_force_N"]
@@ -54,7 +54,7 @@ class StandupWholeBodyController(LeafSystem):
         self,
         schedule: ContactSchedule,
         model: ControllerModel,
-        generator: ReferenceGenerator,
+        generator: TaskReferenceGenerator,
         controller: WholeBodyController,
         num_states: int,
         period_s: float,

@@ -209,3 +209,15 @@ def test_each_robot_rises_to_its_own_erect_height(model, height_m):
     assert scenario.phases.rise.com_height_m is None  # the scenario itself is not changed
     fixed = apply_overrides(scenario, [("phases.rise.com_height_m", 0.56)])
     assert resolve_com_heights(fixed.phases, lambda posture: 1.0).rise.com_height_m == 0.56
+
+
+@pytest.mark.parametrize(("older", "now"), [("soft", "relaxed"), ("stiff", "firm")])
+def test_an_older_tone_loads_under_its_new_name(tmp_path, older, now):
+    """human.body.tone was soft or stiff (stiff also a response); files and --set keep
+    loading with those words, as relaxed and firm."""
+    from drake_standup.config import load_scenario, parse_scenario
+
+    parsed = parse_scenario(f"human:\n  body:\n    tone: {older}\n")
+    assert parsed.human.body.tone == now
+    assert load_scenario(None, [("human.body.tone", older)]).human.body.tone == now
+    assert parse_scenario(f"human:\n  body:\n    tone: {now}\n").human.body.tone == now

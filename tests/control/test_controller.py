@@ -38,7 +38,7 @@ from drake_standup.control.tasks.joint_limits import (
 from drake_standup.control.terms import RobotKinematics
 from drake_standup.robot.limbs import SHOULDER_JOINTS, shoulder_tendon_rows
 from drake_standup.standup.contact_schedule import contact_commands, phase_seat_hold
-from drake_standup.standup.task_references import PhaseReferences, ReferenceGenerator
+from drake_standup.standup.task_references import PhaseReferences, TaskReferenceGenerator
 from drake_standup.standup.transitions import initial_mode
 from drake_standup.standup.whole_body import StandupWholeBodyController
 from drake_standup.world.scene import add_scene, set_seated_state
@@ -103,7 +103,7 @@ class _Rig:
         self.system = StandupWholeBodyController(
             self.schedule,
             ControllerModel(plant, robot, self.specs, self.config, PERIOD_S),
-            ReferenceGenerator(self.config, schedule, as_slice(joints.q_indices), PERIOD_S, g),
+            TaskReferenceGenerator(self.config, schedule, as_slice(joints.q_indices), PERIOD_S, g),
             self.controller,
             plant.num_multibody_states(robot.model_instance),
             PERIOD_S,

@@ -21,7 +21,7 @@ PEOPLE = [
     (height, mass, tone)
     for height in (1.55, 1.90)
     for mass in (50.0, 100.0)
-    for tone in ("soft", "stiff")
+    for tone in ("relaxed", "firm")
 ]
 
 
@@ -48,7 +48,7 @@ def test_any_person_stands_the_robot_up_within_their_strength(height_m, mass_kg,
     # The plant clamps each joint to its strength; a relaxed person never needs it all
     # (a firm one reaches their back's strength: docs/design.md).
     assert m["helper_peak_strength_fraction"] <= 1.0 + 1e-9
-    if tone == "soft":
+    if tone == "relaxed":
         assert m["helper_peak_strength_fraction"] < 0.95
     assert 0.0 < m["helper_peak_shoulder_torque_Nm"] and 0.0 < m["helper_peak_lumbar_torque_Nm"]
 

@@ -37,10 +37,10 @@ CITED = {
 @pytest.mark.parametrize("mass_kg", [50.0, 100.0])
 def test_strength_is_the_studies_scaled_by_mass(mass_kg):
     names = list(CITED)
-    limits, kp, _ = strength_and_impedance(names, BodyHelperConfig(mass_kg=mass_kg, tone="stiff"))
+    limits, kp, _ = strength_and_impedance(names, BodyHelperConfig(mass_kg=mass_kg, tone="firm"))
     for name, limit in zip(names, limits):
         assert limit == pytest.approx(CITED[name] * mass_kg, rel=1e-12), name
-    soft = strength_and_impedance(names, BodyHelperConfig(mass_kg=mass_kg, tone="soft"))
+    soft = strength_and_impedance(names, BodyHelperConfig(mass_kg=mass_kg, tone="relaxed"))
     # Relaxed shoulder and elbow: Shadmehr & Mussa-Ivaldi's 15 and 16 N m/rad at 75 kg.
     assert soft[1][0] == pytest.approx(15.0 * mass_kg / 75.0)
     assert soft[1][2] == pytest.approx(16.0 * mass_kg / 75.0)
@@ -49,8 +49,8 @@ def test_strength_is_the_studies_scaled_by_mass(mass_kg):
 
 def test_trunk_stiffness_is_the_measured_chest_stiffness_at_its_lever():
     """14.5 and 19.8 N/mm at the chest (20 and 40 % effort) at 0.3 m: k r^2."""
-    assert JOINT_IMPEDANCE["soft"]["lumbar"][0] == pytest.approx(14.5e3 * 0.3**2)
-    assert JOINT_IMPEDANCE["stiff"]["lumbar"][0] == pytest.approx(19.8e3 * 0.3**2)
+    assert JOINT_IMPEDANCE["relaxed"]["lumbar"][0] == pytest.approx(14.5e3 * 0.3**2)
+    assert JOINT_IMPEDANCE["firm"]["lumbar"][0] == pytest.approx(19.8e3 * 0.3**2)
 
 
 @pytest.fixture(scope="module")

@@ -25,7 +25,7 @@ from drake_standup.standup.task_references import (
     STIFF,
     CarriedState,
     PhaseReferences,
-    ReferenceGenerator,
+    TaskReferenceGenerator,
     TickInputs,
 )
 from drake_standup.world.sensing import StandingSupport, standing_lean, standing_pull_usage
@@ -44,9 +44,9 @@ def rig(seated_scene):
     plant.SetVelocities(context, instance, rng.normal(scale=0.2, size=plant.num_velocities()))
     x = plant.GetPositionsAndVelocities(context, instance)
     joints = ControllerJoints.of(plant, robot)
-    schedule = PhaseReferences(TABLE, CONFIG, joints.names, joints.q_min, joints.q_max)
+    phases = PhaseReferences(TABLE, CONFIG, joints.names, joints.q_min, joints.q_max)
     g = -plant.gravity_field().gravity_vector()[2]
-    generator = ReferenceGenerator(CONFIG, schedule, as_slice(joints.q_indices), T, g)
+    generator = TaskReferenceGenerator(CONFIG, phases, as_slice(joints.q_indices), T, g)
     kinematics = RobotKinematics(plant, robot, held_frames=[], other_frames=list(HANDS))
     return {
         "plant": plant,
@@ -54,7 +54,7 @@ def rig(seated_scene):
         "context": context,
         "x": x,
         "joints": joints,
-        "schedule": schedule,
+        "phases": phases,
         "generator": generator,
         "kinematics": kinematics,
         "g": g,
@@ -73,10 +73,10 @@ def test_the_schedule_is_the_phase_tables(rig):
     """Per state: K_P as the table says, K_D = 2 zeta sqrt(K_P); the posture target the
     table's joints, clamped posture_limit_margin_rad inside Drake's joint limits; the
     joints a phase does not name hold."""
-    plant, instance, schedule = rig["plant"], rig["instance"], rig["schedule"]
+    plant, instance, phases = rig["plant"], rig["instance"], rig["phases"]
     margin = CONFIG.posture_limit_margin_rad
     for state, name in enumerate(PHASES, start=1):
-        phase, ref = getattr(TABLE, name), schedule[state]
+        phase, ref = getattr(TABLE, name), phases[state]
         np.testing.assert_array_equal(ref.com_kp_per_s2, phase.com_kp_per_s2)
         kd = [2.0 * CONFIG.com_damping_ratio * math.sqrt(kp) for kp in phase.com_kp_per_s2]
         np.testing.assert_allclose(ref.com_kd_per_s, kd, rtol=1e-15)
@@ -93,7 +93,7 @@ def test_the_schedule_is_the_phase_tables(rig):
             assert ref.posture_rad[k] == min(max(phase.posture_rad[joint], low), high)
     # [authors-code]'s elbow target 0.2473 rad lies below the URDF's 0.262 limit: clamped.
     k = rig["joints"].names.index("l_elbow")
-    assert schedule[2].posture_rad[k] > TABLE.forward.posture_rad["l_elbow"]
+    assert phases[2].posture_rad[k] > TABLE.forward.posture_rad["l_elbow"]
 
 
 def _calc(
@@ -235,9 +235,9 @@ def test_the_compliant_offset_settles_only_where_the_standing_feet_hold_the_pull
     away from the pull, the box."""
     limit = 0.6
     joints = rig["joints"]
-    generator = ReferenceGenerator(
+    generator = TaskReferenceGenerator(
         CONFIG,
-        rig["schedule"],
+        rig["phases"],
         as_slice(joints.q_indices),
         T,
         rig["g"],
@@ -252,7 +252,7 @@ def test_the_compliant_offset_settles_only_where_the_standing_feet_hold_the_pull
     half_x = (SUPPORT.cop_x_m[1] - SUPPORT.cop_x_m[0]) / 2
     reach = (CONFIG.lean_max_back_m if pull_N > 0 else CONFIG.lean_max_forward_m) + half_x
     box = np.array(Scenario().compliance.max_offset_m)
-    low, high = generator.com_target.offset_bounds(rig["schedule"][3], hands, weight)
+    low, high = generator.com_target.offset_bounds(rig["phases"][3], hands, weight)
     toward, away = (high[0], low[0]) if pull_N > 0 else (-low[0], -high[0])
     assert toward == pytest.approx(min(max(0.0, (limit - usage) * reach), box[0]), abs=1e-12)
     assert away == -box[0]
@@ -270,7 +270,7 @@ def test_on_the_feet_alone_the_compliant_offset_settles_no_higher_than_the_path(
     box = np.array(Scenario().compliance.max_offset_m)
     pull = np.tile([0.0, 0.0, 0.0, 0.0, 0.0, 10.0], 2)
     for state in (1, 2, 3, 4):
-        low, high = generator.com_target.offset_bounds(rig["schedule"][state], pull, 300.0)
+        low, high = generator.com_target.offset_bounds(rig["phases"][state], pull, 300.0)
         assert high[2] == (0.0 if TABLE.phase(state).lean else box[2])
         assert low[2] == -box[2]
 
@@ -364,10 +364,10 @@ def test_the_posture_and_the_base_target_at_the_first_tick(rig):
     current yaw, pitched forward by the phase's base pitch: the base's up axis tilts
     toward where the robot faces by that angle."""
     references, _ = _calc(rig, 2)
-    joints, schedule = rig["joints"], rig["schedule"]
+    joints, phases = rig["joints"], rig["phases"]
     q = rig["x"][joints.q_indices]
-    state = schedule[2]
-    clamped = np.clip(q, schedule.q_target_min, schedule.q_target_max)
+    state = phases[2]
+    clamped = np.clip(q, phases.q_target_min, phases.q_target_max)
     target = np.where(state.posture_hold, clamped, state.posture_rad)
     blend = T / CONFIG.posture_filter_time_constant_s
     nu = len(q)
@@ -393,14 +393,14 @@ def test_the_posture_filter_steps_as_its_stages_in_series(rig, stages):
     rate a jump at the switch; two, e (1 - (1 - a)^n - n a (1 - a)^(n - 1)), starting at
     rest (zero first step) and never faster than (1 - a)^(1/a - 1) e / tau ~ e / (e tau)."""
     config = dataclasses.replace(CONFIG, posture_filter_stages=stages)
-    generator = ReferenceGenerator(
-        config, rig["schedule"], as_slice(rig["joints"].q_indices), T, rig["g"]
+    generator = TaskReferenceGenerator(
+        config, rig["phases"], as_slice(rig["joints"].q_indices), T, rig["g"]
     )
     terms = rig["kinematics"].calc(rig["x"], [])
     p, _, _, _ = _drake_com(rig)
-    schedule, nu = rig["schedule"], len(rig["joints"].names)
+    phases, nu = rig["phases"], len(rig["joints"].names)
     q = rig["x"][rig["joints"].q_indices]
-    gap = np.where(schedule[2].posture_hold, 0.0, schedule[2].posture_rad - q)
+    gap = np.where(phases[2].posture_hold, 0.0, phases[2].posture_rad - q)
     a = T / config.posture_filter_time_constant_s
     posture, references = np.zeros(2 + 3 * nu), []
     for _ in range(120):
@@ -435,7 +435,7 @@ def test_the_generator_integrates_the_angular_momentum_over_its_ticks(rig):
     without a pull."""
     terms = rig["kinematics"].calc(rig["x"], [])
     p, _, L, _ = _drake_com(rig)
-    nu = len(rig["generator"].schedule.q_target_min)
+    nu = len(rig["generator"].phases.q_target_min)
     now = TickInputs(2, np.concatenate([p, np.zeros(6)]), path_progress=0.0)
     carried = CarriedState(np.zeros(3), np.zeros(2 + 3 * nu), np.zeros(3), 0.0, np.zeros(6))
     for _ in range(4):
