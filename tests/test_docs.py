@@ -162,3 +162,17 @@ def test_the_check_finds_an_undocumented_key():
     ]
     # A key named only outside the section does not count: "signals.npz" is not a metric.
     assert undocumented_metrics({"time_s": 0.0}, section) == ["time_s"]
+
+
+def test_the_design_is_short_and_its_decisions_are_records():
+    """docs/design.md is the design today (at most 500 lines); each measured decision is
+    a record in docs/decisions/ with its question, its choice and its commit."""
+    assert len((REPO / "docs" / "design.md").read_text().splitlines()) <= 500
+    records = sorted((REPO / "docs" / "decisions").glob("[0-9][0-9][0-9]-*.md"))
+    assert len(records) >= 10
+    index = (REPO / "docs" / "decisions" / "README.md").read_text()
+    for record in records:
+        text = record.read_text()
+        assert "**Question.**" in text and "**Choice.**" in text, record.name
+        assert named_commits(text.split("## What was measured")[0]), record.name
+        assert f"]({record.name})" in index, record.name

@@ -42,7 +42,7 @@ class ControllerConfig:
     # ... and keep each able to stop before its limit braking at this much, the
     # braking-distance bound (control/tasks/joint_limits.py; None: none). Without it the
     # shoulders and the knees reached their stops at 3-5 rad/s and rang the feet
-    # (docs/design.md, "Chatter at the seat's release and at the rise's end"). rad/s^2.
+    # (docs/design.md, "Chatter at the seat's release"). rad/s^2.
     joint_braking_rad_per_s2: float | None = 20.0
     # ... softly: a slack s per joint at the cost w s^2 (rad/s^2); hard bounds made the
     # QP infeasible where the soles pin the legs or the pull holds the shoulders.

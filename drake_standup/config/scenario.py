@@ -249,7 +249,8 @@ class StandupConfig:
     # Such a pull first braces the arms: they hold the posture they sat with instead of
     # reaching out, which brings the hands lower and nearer the feet and shortens the
     # pull's lever; the stand-up waits only if the pull is beyond the feet braced too,
-    # and the arms reach out again once it eases (docs/design.md, "A strong pull").
+    # and the arms reach out again once it eases (docs/decisions/010-reactive-partners.md,
+    # "A strong pull").
     brace_arms: bool = True
     # After a hindering pull stops, the stand-up waits this long: the pull is over, and
     # the arms it swung back return to their posture first. s.

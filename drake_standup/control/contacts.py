@@ -77,7 +77,7 @@ def wrench_cone_matrix(spec: ContactSpec) -> np.ndarray:
     so that at a corner of the box there is none. Without it the QP held the CoP at the
     box's toe-outer corner with the full mu_t f_z of yaw moment at the rise's end: the
     compliant sole, bearing on its corner, could not give it, and the feet twisted
-    (docs/design.md, "Chatter at the seat's release and at the rise's end").
+    (docs/design.md, "Chatter at the seat's release").
 
     A point contact keeps the pyramid only: K (4 x 3) on f_C.
     """
