@@ -124,3 +124,27 @@ def test_against_the_reactive_partner_advancement_is_sooner_than_stiff(tmp_path,
         [compare.resolve_helper("reactive")], list(RESPONSES), tmp_path, progress=False
     )
     assert (tmp_path / "results.csv").read_text() == first
+
+
+def test_the_docs_tables_are_what_their_csvs_give():
+    """Each results table of the docs is written from its campaign's CSV
+    (studies/doc_tables.py): one source for each number."""
+    from drake_standup.studies.doc_tables import TABLES, main, placed
+
+    for table in TABLES:
+        text = table.document.read_text()
+        assert placed(text, table) == text, f"{table.name}: run doc_tables"
+    assert main(["--check"]) == 0
+
+
+def test_a_table_edited_by_hand_is_caught(tmp_path):
+    import dataclasses
+
+    from drake_standup.studies.doc_tables import TABLES, placed
+
+    table = TABLES[0]
+    document = tmp_path / "doc.md"
+    edited = placed(table.document.read_text(), table).replace("| 2.85 |", "| 2.75 |", 1)
+    document.write_text(edited)
+    moved = dataclasses.replace(table, document=document)
+    assert placed(document.read_text(), moved) != document.read_text()
