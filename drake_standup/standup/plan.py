@@ -80,16 +80,9 @@ def make_plan(scenario: Scenario, station: Station) -> StandupPlan:
     """The plan for scenario's robot in the station's scene: the forward ends from where the
     soles are seated (resolve_com_x); the lift-off's postures from the seated pose
     (resolve_postures); each standing posture's CoM height from forward kinematics
-    (scene.standing, which works each posture out once per build); the rise's is the
-    station's own where it stands erect (its standing support)."""
-    rise = scenario.phases.rise
-    standing = station.scene.standing
-
-    def erect(posture_rad: dict[str, float]) -> float:
-        if rise.com_height_m is None and posture_rad == rise.posture_rad:
-            return station.standing.com_height_m
-        return standing.erect_com_height_m(posture_rad)
-
+    (scene.standing, which works each posture out once per build and so gives the
+    station's own standing support the same numbers)."""
+    erect = station.scene.standing.erect_com_height_m
     seated = station.scene.seated
     soles_x = scenario.chair.seat_edge_x_m() + seated.feet_ahead_of_seat_edge_m
     shift, limits = seated_shift(station.scene)
