@@ -6,6 +6,7 @@ inputs); runner.py logs and reads those, never a system's insides.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -277,6 +278,7 @@ def _add_visuals(
 ON_GRID_HORIZON_S = 3600.0
 
 
+@functools.cache  # pure; each build asks the same few periods (publishes, chunks)
 def on_step_grid(period_s: float, step_s: float) -> float:
     """period_s as a whole number n (>= 1) of plant steps, the nearest n whose event times
     are the plant's own in floating point: Drake puts a periodic event k at k * period
@@ -287,6 +289,8 @@ def on_step_grid(period_s: float, step_s: float) -> float:
     plant, config.validate)."""
     nearest = max(1, round(period_s / step_s))
     for n in sorted(range(1, 2 * nearest + 1), key=lambda n: (abs(n - nearest), n)):
+        if n == 1:  # k * (1 h) is k h exactly: every step is on the grid
+            return step_s
         k = np.arange(1, int(ON_GRID_HORIZON_S / (n * step_s)) + 2)
         if np.array_equal(k * (step_s * n), (k * n) * step_s):
             return step_s * n
