@@ -11,7 +11,7 @@ errors.py      ScenarioError: one line naming the key or file
 """
 
 from drake_standup.config.chair import ChairConfig, InitialPose, chair_file
-from drake_standup.config.controller import QP_SOLVERS, ControllerConfig
+from drake_standup.config.controller import MODEL_LIBRARIES, QP_SOLVERS, ControllerConfig
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import check_output_dir, read_text_file
 from drake_standup.config.loading import (
@@ -45,6 +45,7 @@ __all__ = [
     "DEFAULT_SCENARIO",
     "EFFORT_LIMIT_NM",
     "JOINT_TABLES",
+    "MODEL_LIBRARIES",
     "QP_SOLVERS",
     "RULES",
     "SCENARIO_DIR",

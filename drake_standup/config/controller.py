@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 
 # The QP solvers the controller can use (control/backends.py: make_backend).
 QP_SOLVERS = ("daqp", "osqp", "clarabel")
+# The libraries that can compute the controller's model (control/model.py).
+MODEL_LIBRARIES = ("pinocchio", "drake")
 
 
 @dataclass
@@ -188,3 +190,6 @@ class ControllerConfig:
     mass_scale_bounds: list[float] = field(default_factory=lambda: [0.7, 1.3])
     # QP solver: daqp (the fastest here, exact equalities), or Drake's osqp / clarabel.
     qp_solver: str = "daqp"
+    # What computes the controller's model: pinocchio (one pass, the same tree as the
+    # plant's, docs/decisions/015-controller-model-library.md), or Drake's plant itself.
+    model_library: str = "pinocchio"

@@ -17,7 +17,7 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 
 from drake_standup.config.body import TONES
 from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig
-from drake_standup.config.controller import QP_SOLVERS
+from drake_standup.config.controller import MODEL_LIBRARIES, QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
 from drake_standup.config.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
@@ -80,6 +80,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (SEAT_PADS, "phases.*.unload[*]"),
     (WHEN_HINDERED, "phases.*.when_hindered"),
     (QP_SOLVERS, "controller.qp_solver"),
+    (MODEL_LIBRARIES, "controller.model_library"),
     (tuple(GetIntegrationSchemes()), "simulator.integration_scheme"),
     (("point", "hydroelastic", "hydroelastic_with_fallback"), "plant.contact_model"),
     (("", "tamsi", "sap", "similar", "lagged"), "plant.discrete_contact_approximation"),

@@ -158,24 +158,46 @@ class RobotKinematics:
     ) -> RobotTerms:
         """Terms at the robot state x = [q; v], for the named frames only (each frame's
         Jacobian is a Drake call: the hands are left out while nobody pulls them)."""
-        plant, context, world, origin = self._plant, self._context, self._world, self._origin
-        request, n_held = self._request(frame_names)
-        plant.SetPositionsAndVelocities(context, x)
+        M, h, J_F, J_P, Jdotv_P, J_W = self._pass(x, frame_names, world_frame_names)
         q, v = x[: self.nq], x[self.nq :]
-        M = plant.CalcMassMatrix(context)
-        h = plant.CalcBiasTerm(context)
-        h -= self._gravity_W @ M[3:6]
         h += self._damping * v
         mass = self.mass_kg
         p_BoCom = M.take(self._com_entries) / mass  # module docstring
         L_WCom = M[:6] @ v  # [h_WBo; l_W], shifted to the CoM below
         L_WCom[:3] -= cross(p_BoCom, L_WCom[3:])
-        R_WB = rotation_from_quaternion(q[self._quaternion])
+        return RobotTerms(
+            q=q,
+            v=v,
+            M=M,
+            h=h,
+            mass_kg=mass,
+            p_WCom=q[self._p_WBo] + p_BoCom,
+            p_BoCom=p_BoCom,
+            v_WCom=L_WCom[3:] / mass,
+            L_WCom=L_WCom,
+            R_WB=rotation_from_quaternion(q[self._quaternion]),
+            frame_names=frame_names,
+            J_F=J_F,
+            J_P=J_P,
+            Jdotv_P=Jdotv_P,
+            world_frame_names=world_frame_names,
+            J_W=J_W,
+            frame_rotations=partial(self.frame_rotations, q, frame_names),
+        )
 
+    def _pass(self, x: np.ndarray, frame_names: list[str], world_frame_names) -> tuple:
+        """(M, C v - tau_g, J_F, J_P, Jdotv_P, J_W) at x (RobotTerms' fields), by Drake."""
+        plant, context, world, origin = self._plant, self._context, self._world, self._origin
+        request, n_held = self._request(frame_names)
+        plant.SetPositionsAndVelocities(context, x)
+        M = plant.CalcMassMatrix(context)
+        h = plant.CalcBiasTerm(context)
+        h -= self._gravity_W @ M[3:6]
         nv, kV = self.nv, JacobianWrtVariable.kV
         J_F = np.empty((len(frame_names), 6, nv))
         J_P = np.empty((n_held, 6, nv))
         Jdotv_P = np.zeros((n_held, 6))
+        R_WB = None
         j = 0
         for k, (frame, p_FP, held, on_base) in enumerate(request):
             J_F[k] = plant.CalcJacobianSpatialVelocity(context, kV, frame, origin, world, frame)
@@ -190,8 +212,10 @@ class RobotKinematics:
                     context, kV, frame, origin if p_FP is None else p_FP, world, frame
                 ).get_coeffs()
             else:  # w x (w x p_BoP) (module docstring), in B, then in F
+                if R_WB is None:
+                    R_WB = rotation_from_quaternion(x[self._quaternion])
                 p_BP, R_FB = on_base
-                w_B = v[:3] @ R_WB
+                w_B = x[self.nq : self.nq + 3] @ R_WB
                 Jdotv_P[j, 3:] = R_FB @ cross(w_B, cross(w_B, p_BP))
             j += 1
         J_W = np.empty((len(world_frame_names), 6, nv))
@@ -199,25 +223,7 @@ class RobotKinematics:
             J_W[i] = plant.CalcJacobianSpatialVelocity(
                 context, kV, self._frames[name][0], origin, world, world
             )
-        return RobotTerms(
-            q=q,
-            v=v,
-            M=M,
-            h=h,
-            mass_kg=mass,
-            p_WCom=q[self._p_WBo] + p_BoCom,
-            p_BoCom=p_BoCom,
-            v_WCom=L_WCom[3:] / mass,
-            L_WCom=L_WCom,
-            R_WB=R_WB,
-            frame_names=frame_names,
-            J_F=J_F,
-            J_P=J_P,
-            Jdotv_P=Jdotv_P,
-            world_frame_names=world_frame_names,
-            J_W=J_W,
-            frame_rotations=partial(self.frame_rotations, q, frame_names),
-        )
+        return M, h, J_F, J_P, Jdotv_P, J_W
 
     def frame_rotations(self, q: np.ndarray, frame_names: list[str]) -> np.ndarray:
         """R_WF (k, 3, 3) of the named frames at the positions q."""

@@ -47,6 +47,7 @@ from drake_standup.standup.plan import StandupPlan
 from drake_standup.standup.state_machine import StandupStateMachine
 from drake_standup.standup.task_references import PhaseReferences, TaskReferenceGenerator
 from drake_standup.standup.whole_body import StandupWholeBodyController
+from drake_standup.world.scene import robot_dynamics
 from drake_standup.world.sensing import standing_lean
 from drake_standup.world.station import Station
 
@@ -132,7 +133,14 @@ def make_standup_controller(
         station.arm_joints,
         braced_drop_m=station.braced_drop_m,
     )
-    model = ControllerModel(plant, robot, specs, config, period_s)
+    model = ControllerModel(
+        plant,
+        robot,
+        specs,
+        config,
+        period_s,
+        robot_dynamics(station.scene) if config.model_library == "pinocchio" else None,
+    )
     systems = {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()

@@ -18,10 +18,11 @@ from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.systems.framework import Context, DiagramBuilder
 
 from drake_standup.config import Scenario, ScenarioError, chair_file
-from drake_standup.config.inputs import add_sdf
+from drake_standup.config.inputs import BASE_LINK, add_sdf
 from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.helper.body import GRIPS, HelperBody, add_helper_body
+from drake_standup.robot.dynamics import RobotDynamics
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
 from drake_standup.world.chair import chair_sdf
 from drake_standup.world.perturbations import scale_friction
@@ -53,6 +54,8 @@ class Scene:
     alone: Scene | None = None
     # The robot standing in a posture, each posture's numbers worked out once (add_scene).
     standing: StandingGeometry | None = None
+    # The robot's dynamics by Pinocchio, shared by every reader of a state (robot_dynamics).
+    dynamics: RobotDynamics | None = None
 
 
 @dataclass(frozen=True)
@@ -179,6 +182,17 @@ def add_scene(
     scene = Scene(plant, scene_graph, robot, seated, helper, alone)
     scene.standing = StandingGeometry(scene, scenario.initial.base_rpy_rad[2])
     return scene
+
+
+def robot_dynamics(scene: Scene) -> RobotDynamics:
+    """The robot's RobotDynamics (robot/dynamics.py), one per scene: the sensed CoM and
+    the controller's model read one pass a state. Built from the robot's own plant
+    (scene.alone with a helper's body: the same tree)."""
+    own = scene.alone or scene
+    if own.dynamics is None:
+        base = own.plant.GetBodyByName(BASE_LINK, own.robot.model_instance)
+        own.dynamics = RobotDynamics.of(own.plant, own.robot.model_instance, base)
+    return own.dynamics
 
 
 def without_body(scenario: Scenario) -> Scenario:

@@ -17,6 +17,7 @@ from pydrake.systems.framework import BasicVector, Context, LeafSystem
 from drake_standup.helper.hands import TASK_FRAMES
 from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.balance import static_lean
+from drake_standup.robot.dynamics import RobotDynamics
 from drake_standup.robot.icub import Robot
 from drake_standup.robot.spatial import cross
 
@@ -162,8 +163,12 @@ class RobotSensing(LeafSystem):
         thigh_points: dict[str, np.ndarray] | None = None,
         standing: StandingSupport | None = None,
         braced: StandingSupport | None = None,
+        dynamics: RobotDynamics | None = None,
     ):
+        """dynamics: the CoM from the pass the controller's model shares
+        (robot/dynamics.py); None: from Drake's plant."""
         super().__init__()
+        self._dynamics = dynamics
         self._plant = plant
         self._instance = robot.model_instance
         self._context = plant.CreateDefaultContext()
@@ -232,6 +237,8 @@ class RobotSensing(LeafSystem):
             self._context_state = state
 
     def _calc_kinematics(self, context: Context) -> tuple[np.ndarray, np.ndarray]:
+        if self._dynamics is not None:
+            return self._dynamics.com(self._state.Eval(context))
         self._set_plant_state(context, check=False)
         plant, c = self._plant, self._context
         com = plant.CalcCenterOfMassPositionInWorld(c, [self._instance])

@@ -40,7 +40,7 @@ from drake_standup.ports.payloads import HAND_WRENCHES
 from drake_standup.robot.icub import ActuatedJoints, Robot, actuated_joints, arm_joint_names
 from drake_standup.world.pad_forces import ContactForceReporter
 from drake_standup.world.perturbations import NoisyWrenchSensor, PushSource
-from drake_standup.world.scene import Scene, add_scene, check_com_heights
+from drake_standup.world.scene import Scene, add_scene, check_com_heights, robot_dynamics
 from drake_standup.world.sensing import (
     FeetReach,
     RobotSensing,
@@ -230,7 +230,16 @@ def _add_sensing(
     braced = support(braced_posture(rise.posture_rad, arm_joints), None)
     sensing = builder.AddNamedSystem(
         "sensing",
-        RobotSensing(plant, robot, heel_points(robot), thigh_points(robot), standing, braced),
+        RobotSensing(
+            plant,
+            robot,
+            heel_points(robot),
+            thigh_points(robot),
+            standing,
+            braced,
+            # The CoM from the controller model's pass, where Pinocchio computes it.
+            robot_dynamics(scene) if scenario.controller.model_library == "pinocchio" else None,
+        ),
     )
     robot_state = plant.get_state_output_port(robot.model_instance)
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))

@@ -73,3 +73,33 @@ def test_dot_shows_every_system_in_its_box(built, tmp_path):
     dot = export_diagram(built.diagram, tmp_path)[0].read_text()
     for name in ("station", "standup_controller", "human", *STATION, *CONTROLLER):
         assert f"name={name}" in dot, name
+
+
+def test_the_sensed_com_and_the_controllers_model_share_one_pass_a_state():
+    """Issue 48: the CoM the advancement reads and the controller's model come from one
+    Pinocchio pass a robot state (world/scene.py robot_dynamics), not one each: the
+    passes number the controller's ticks (one state each) while the sensed CoM is read
+    too (the state machine's and the advancement's readers)."""
+    from pydrake.systems.analysis import Simulator
+
+    from drake_standup.world.scene import robot_dynamics
+
+    built = build_diagram(load_scenario())
+    dynamics = robot_dynamics(built.station.scene)
+    systems = {s.get_name(): s for s in built.diagram.GetSystems()}
+    sensing = systems["station"].GetSubsystemByName("sensing")
+    controller = systems["standup_controller"].GetSubsystemByName("controller")
+    assert sensing._dynamics is dynamics and controller.model.kinematics.dynamics is dynamics
+    com_reads = []
+    com = dynamics.com
+    dynamics.com = lambda x: com_reads.append(1) or com(x)
+    simulator = Simulator(built.diagram)
+    simulator.Initialize()
+    simulator.AdvanceTo(1.0)
+    dynamics.passes = 0
+    com_reads.clear()
+    built.controller.reset_timing()
+    simulator.AdvanceTo(1.4)
+    ticks = len(built.controller.timing_s())
+    assert ticks >= 90 and len(com_reads) >= 20, (ticks, len(com_reads))
+    assert dynamics.passes <= ticks + 1, (dynamics.passes, ticks)
