@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 # The QP solvers the controller can use (control/backends.py: make_backend).
 QP_SOLVERS = ("daqp", "osqp", "clarabel")
 # The libraries that can compute the controller's model (control/model.py).
-MODEL_LIBRARIES = ("pinocchio", "drake")
+MODEL_LIBRARIES = ("drake", "pinocchio")
 
 
 @dataclass
@@ -190,6 +190,7 @@ class ControllerConfig:
     mass_scale_bounds: list[float] = field(default_factory=lambda: [0.7, 1.3])
     # QP solver: daqp (the fastest here, exact equalities), or Drake's osqp / clarabel.
     qp_solver: str = "daqp"
-    # What computes the controller's model: pinocchio (one pass, the same tree as the
-    # plant's, docs/decisions/015-controller-model-library.md), or Drake's plant itself.
-    model_library: str = "pinocchio"
+    # What computes the controller's model: Drake's plant itself, or pinocchio (one pass
+    # of the same tree, shared with the sensed CoM; `pip install .[pinocchio]`). Drake:
+    # Pinocchio's pass measured no faster in the loop (docs/decisions/015-...).
+    model_library: str = "drake"

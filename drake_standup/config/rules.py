@@ -229,6 +229,14 @@ def validate(scenario: Scenario) -> Scenario:
     _check_names(scenario, data, check_robot_model(scenario.robot.model))
     if scenario.chair.file:
         check_chair_file(scenario.chair.file)
+    if scenario.controller.model_library == "pinocchio":
+        import importlib.util
+
+        if importlib.util.find_spec("pinocchio") is None:
+            raise ScenarioError(
+                "controller.model_library: 'pinocchio' needs the optional package "
+                "(pip install 'drake_standup[pinocchio]'); accepted: drake"
+            )
     return scenario
 
 

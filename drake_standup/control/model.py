@@ -20,10 +20,8 @@ from drake_standup.config import ControllerConfig
 from drake_standup.control.contacts import CONTACTS, ContactCommands, ContactSpec
 from drake_standup.control.mass import next_mass_state
 from drake_standup.control.pad_dynamics import PadCompliance
-from drake_standup.control.pinocchio_terms import PinocchioKinematics
 from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.ports.payloads import HAND_WRENCHES
-from drake_standup.robot.dynamics import RobotDynamics
 from drake_standup.robot.icub import Robot, actuated_joints
 
 HANDS = ("l_hand", "r_hand")
@@ -137,17 +135,19 @@ class ControllerModel:
         specs: list[ContactSpec],
         config: ControllerConfig,
         period_s: float,
-        dynamics: RobotDynamics | None = None,
+        dynamics=None,
     ):
         """dynamics: the robot's Pinocchio pass to share (world/scene.py robot_dynamics),
         with controller.model_library pinocchio."""
         if [spec.frame for spec in specs] != list(CONTACTS):
             raise ValueError(f"contact specs must be {CONTACTS}")
         self.specs = specs
-        pinocchio = {} if dynamics is None else {"dynamics": dynamics}
-        library = partial(PinocchioKinematics, **pinocchio)
-        if config.model_library == "drake":
-            library = RobotKinematics
+        library = RobotKinematics
+        if config.model_library == "pinocchio":  # an optional package: imported if asked
+            from drake_standup.control.pinocchio_terms import PinocchioKinematics
+
+            pinocchio = {} if dynamics is None else {"dynamics": dynamics}
+            library = partial(PinocchioKinematics, **pinocchio)
         self.kinematics = library(
             plant,
             robot,

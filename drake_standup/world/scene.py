@@ -22,7 +22,6 @@ from drake_standup.config.inputs import BASE_LINK, add_sdf
 from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.helper.body import GRIPS, HelperBody, add_helper_body
-from drake_standup.robot.dynamics import RobotDynamics
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
 from drake_standup.world.chair import chair_sdf
 from drake_standup.world.perturbations import scale_friction
@@ -55,7 +54,7 @@ class Scene:
     # The robot standing in a posture, each posture's numbers worked out once (add_scene).
     standing: StandingGeometry | None = None
     # The robot's dynamics by Pinocchio, shared by every reader of a state (robot_dynamics).
-    dynamics: RobotDynamics | None = None
+    dynamics: object | None = None
 
 
 @dataclass(frozen=True)
@@ -184,10 +183,12 @@ def add_scene(
     return scene
 
 
-def robot_dynamics(scene: Scene) -> RobotDynamics:
+def robot_dynamics(scene: Scene):
     """The robot's RobotDynamics (robot/dynamics.py), one per scene: the sensed CoM and
     the controller's model read one pass a state. Built from the robot's own plant
     (scene.alone with a helper's body: the same tree)."""
+    from drake_standup.robot.dynamics import RobotDynamics  # pinocchio is optional
+
     own = scene.alone or scene
     if own.dynamics is None:
         base = own.plant.GetBodyByName(BASE_LINK, own.robot.model_instance)

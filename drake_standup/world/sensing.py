@@ -17,7 +17,6 @@ from pydrake.systems.framework import BasicVector, Context, LeafSystem
 from drake_standup.helper.hands import TASK_FRAMES
 from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.balance import static_lean
-from drake_standup.robot.dynamics import RobotDynamics
 from drake_standup.robot.icub import Robot
 from drake_standup.robot.spatial import cross
 
@@ -163,10 +162,10 @@ class RobotSensing(LeafSystem):
         thigh_points: dict[str, np.ndarray] | None = None,
         standing: StandingSupport | None = None,
         braced: StandingSupport | None = None,
-        dynamics: RobotDynamics | None = None,
+        dynamics=None,
     ):
-        """dynamics: the CoM from the pass the controller's model shares
-        (robot/dynamics.py); None: from Drake's plant."""
+        """dynamics: a RobotDynamics (robot/dynamics.py), the CoM from the pass the
+        controller's model shares; None: from Drake's plant."""
         super().__init__()
         self._dynamics = dynamics
         self._plant = plant

@@ -265,3 +265,28 @@ def test_every_number_and_name_is_checked_by_a_rule_or_named_unbounded():
             continue
         covered = any(re.fullmatch(p, k) for p in patterns for k in (key, key.rsplit("[", 1)[0]))
         assert covered or re.fullmatch(UNBOUNDED, key), key
+
+
+def test_the_pinocchio_model_without_its_package_is_a_one_line_error(monkeypatch):
+    """controller.model_library: pinocchio needs the optional package: without it, one
+    ScenarioError line naming the key and the accepted value."""
+    import dataclasses
+    import importlib.util
+
+    from drake_standup.config import Scenario, ScenarioError
+    from drake_standup.config.rules import validate
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util,
+        "find_spec",
+        lambda name, *a: None if name == "pinocchio" else real(name, *a),
+    )
+    base = Scenario()
+    scenario = dataclasses.replace(
+        base, controller=dataclasses.replace(base.controller, model_library="pinocchio")
+    )
+    with pytest.raises(ScenarioError) as info:
+        validate(scenario)
+    assert "controller.model_library" in str(info.value) and "\n" not in str(info.value)
+    validate(base)  # drake, the default, needs nothing more

@@ -76,15 +76,19 @@ def test_dot_shows_every_system_in_its_box(built, tmp_path):
 
 
 def test_the_sensed_com_and_the_controllers_model_share_one_pass_a_state():
-    """Issue 48: the CoM the advancement reads and the controller's model come from one
-    Pinocchio pass a robot state (world/scene.py robot_dynamics), not one each: the
-    passes number the controller's ticks (one state each) while the sensed CoM is read
-    too (the state machine's and the advancement's readers)."""
+    """Issue 48, with controller.model_library pinocchio: the CoM the advancement reads
+    and the controller's model come from one Pinocchio pass a robot state (world/scene.py
+    robot_dynamics), not one each: the passes number the controller's ticks (one state
+    each) while the sensed CoM is read too."""
+    import dataclasses
+
     from pydrake.systems.analysis import Simulator
 
     from drake_standup.world.scene import robot_dynamics
 
-    built = build_diagram(load_scenario())
+    base = load_scenario()
+    controller = dataclasses.replace(base.controller, model_library="pinocchio")
+    built = build_diagram(dataclasses.replace(base, controller=controller))
     dynamics = robot_dynamics(built.station.scene)
     systems = {s.get_name(): s for s in built.diagram.GetSystems()}
     sensing = systems["station"].GetSubsystemByName("sensing")
