@@ -136,13 +136,15 @@ class ControllerModel:
         config: ControllerConfig,
         period_s: float,
         dynamics=None,
+        last_com=None,
     ):
         """dynamics: the robot's Pinocchio pass to share (world/scene.py robot_dynamics),
-        with controller.model_library pinocchio."""
+        with controller.model_library pinocchio; last_com: where Drake's model puts each
+        state's CoM for the sensing (robot_last_com)."""
         if [spec.frame for spec in specs] != list(CONTACTS):
             raise ValueError(f"contact specs must be {CONTACTS}")
         self.specs = specs
-        library = RobotKinematics
+        library = partial(RobotKinematics, last_com=last_com)
         if config.model_library == "pinocchio":  # an optional package: imported if asked
             from drake_standup.control.pinocchio_terms import PinocchioKinematics
 

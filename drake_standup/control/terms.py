@@ -29,6 +29,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 
 from drake_standup.robot.icub import Robot
+from drake_standup.robot.last_com import LastCoM
 from drake_standup.robot.spatial import cross, rotation_from_quaternion
 
 BASE_BODY = "root_link"
@@ -84,9 +85,12 @@ class RobotKinematics:
         held_frames: list[str],
         other_frames: list[str],
         hold_points_m: dict[str, tuple[float, float, float]] | None = None,
+        last_com: LastCoM | None = None,
     ):
         """held_frames get the Jacobian and bias acceleration Jdot v of their hold point
-        too (hold_points_m: its position in the frame; default the origin)."""
+        too (hold_points_m: its position in the frame; default the origin); last_com
+        gets each state's CoM for the sensing (robot/last_com.py)."""
+        self.last_com = last_com
         instance = robot.model_instance
         if plant.num_velocities() != plant.num_velocities(instance) or plant.num_positions() != (
             plant.num_positions(instance)
@@ -165,15 +169,18 @@ class RobotKinematics:
         p_BoCom = M.take(self._com_entries) / mass  # module docstring
         L_WCom = M[:6] @ v  # [h_WBo; l_W], shifted to the CoM below
         L_WCom[:3] -= cross(p_BoCom, L_WCom[3:])
+        p_WCom, v_WCom = q[self._p_WBo] + p_BoCom, L_WCom[3:] / mass
+        if self.last_com is not None:
+            self.last_com.put(x, p_WCom, v_WCom)
         return RobotTerms(
             q=q,
             v=v,
             M=M,
             h=h,
             mass_kg=mass,
-            p_WCom=q[self._p_WBo] + p_BoCom,
+            p_WCom=p_WCom,
             p_BoCom=p_BoCom,
-            v_WCom=L_WCom[3:] / mass,
+            v_WCom=v_WCom,
             L_WCom=L_WCom,
             R_WB=rotation_from_quaternion(q[self._quaternion]),
             frame_names=frame_names,

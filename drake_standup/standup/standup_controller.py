@@ -47,7 +47,7 @@ from drake_standup.standup.plan import StandupPlan
 from drake_standup.standup.state_machine import StandupStateMachine
 from drake_standup.standup.task_references import PhaseReferences, TaskReferenceGenerator
 from drake_standup.standup.whole_body import StandupWholeBodyController
-from drake_standup.world.scene import robot_dynamics
+from drake_standup.world.scene import robot_dynamics, robot_last_com
 from drake_standup.world.sensing import standing_lean
 from drake_standup.world.station import Station
 
@@ -140,6 +140,7 @@ def make_standup_controller(
         config,
         period_s,
         robot_dynamics(station.scene) if config.model_library == "pinocchio" else None,
+        robot_last_com(station.scene),
     )
     systems = {
         "state_machine": StandupStateMachine(

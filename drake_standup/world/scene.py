@@ -23,6 +23,7 @@ from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.helper.body import GRIPS, HelperBody, add_helper_body
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
+from drake_standup.robot.last_com import LastCoM
 from drake_standup.world.chair import chair_sdf
 from drake_standup.world.perturbations import scale_friction
 from drake_standup.world.seating import SeatedPose, seated_pose
@@ -55,6 +56,8 @@ class Scene:
     standing: StandingGeometry | None = None
     # The robot's dynamics by Pinocchio, shared by every reader of a state (robot_dynamics).
     dynamics: object | None = None
+    # The controller's model's CoM of the last state, for the sensing (robot_last_com).
+    last_com: LastCoM | None = None
 
 
 @dataclass(frozen=True)
@@ -194,6 +197,15 @@ def robot_dynamics(scene: Scene):
         base = own.plant.GetBodyByName(BASE_LINK, own.robot.model_instance)
         own.dynamics = RobotDynamics.of(own.plant, own.robot.model_instance, base)
     return own.dynamics
+
+
+def robot_last_com(scene: Scene) -> LastCoM:
+    """The robot's LastCoM (robot/last_com.py), one per scene: the controller's Drake model
+    puts each state's CoM, the sensing reads it."""
+    own = scene.alone or scene
+    if own.last_com is None:
+        own.last_com = LastCoM()
+    return own.last_com
 
 
 def without_body(scenario: Scenario) -> Scenario:

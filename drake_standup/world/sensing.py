@@ -18,6 +18,7 @@ from drake_standup.helper.hands import TASK_FRAMES
 from drake_standup.ports.caching import declare_cached
 from drake_standup.robot.balance import static_lean
 from drake_standup.robot.icub import Robot
+from drake_standup.robot.last_com import LastCoM
 from drake_standup.robot.spatial import cross
 
 
@@ -163,11 +164,13 @@ class RobotSensing(LeafSystem):
         standing: StandingSupport | None = None,
         braced: StandingSupport | None = None,
         dynamics=None,
+        last_com: LastCoM | None = None,
     ):
         """dynamics: a RobotDynamics (robot/dynamics.py), the CoM from the pass the
-        controller's model shares; None: from Drake's plant."""
+        controller's model shares; last_com: the controller's model's CoM of the state,
+        where it computed it (robot/last_com.py); else from Drake's plant."""
         super().__init__()
-        self._dynamics = dynamics
+        self._dynamics, self._last_com = dynamics, last_com
         self._plant = plant
         self._instance = robot.model_instance
         self._context = plant.CreateDefaultContext()
@@ -238,6 +241,10 @@ class RobotSensing(LeafSystem):
     def _calc_kinematics(self, context: Context) -> tuple[np.ndarray, np.ndarray]:
         if self._dynamics is not None:
             return self._dynamics.com(self._state.Eval(context))
+        if self._last_com is not None:
+            com = self._last_com.get(self._state.Eval(context))
+            if com is not None:
+                return com
         self._set_plant_state(context, check=False)
         plant, c = self._plant, self._context
         com = plant.CalcCenterOfMassPositionInWorld(c, [self._instance])

@@ -40,7 +40,13 @@ from drake_standup.ports.payloads import HAND_WRENCHES
 from drake_standup.robot.icub import ActuatedJoints, Robot, actuated_joints, arm_joint_names
 from drake_standup.world.pad_forces import ContactForceReporter
 from drake_standup.world.perturbations import NoisyWrenchSensor, PushSource
-from drake_standup.world.scene import Scene, add_scene, check_com_heights, robot_dynamics
+from drake_standup.world.scene import (
+    Scene,
+    add_scene,
+    check_com_heights,
+    robot_dynamics,
+    robot_last_com,
+)
 from drake_standup.world.sensing import (
     FeetReach,
     RobotSensing,
@@ -239,6 +245,7 @@ def _add_sensing(
             braced,
             # The CoM from the controller model's pass, where Pinocchio computes it.
             robot_dynamics(scene) if scenario.controller.model_library == "pinocchio" else None,
+            robot_last_com(scene),
         ),
     )
     robot_state = plant.get_state_output_port(robot.model_instance)

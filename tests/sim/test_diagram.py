@@ -107,3 +107,36 @@ def test_the_sensed_com_and_the_controllers_model_share_one_pass_a_state():
     ticks = len(built.controller.timing_s())
     assert ticks >= 90 and len(com_reads) >= 20, (ticks, len(com_reads))
     assert dynamics.passes <= ticks + 1, (dynamics.passes, ticks)
+
+
+def test_the_sensed_com_reads_the_controllers_com_of_the_same_state():
+    """Issue 48, with Drake's model (the default): the sensing reads the CoM the
+    controller's tick computed for the same state (robot/last_com.py) instead of
+    computing it again; its reads are those of the sensing's own CoM output, and the
+    values are Drake's CoM of that state to round-off."""
+    from pydrake.systems.analysis import Simulator
+
+    from drake_standup.world.scene import robot_last_com
+
+    built = build_diagram(load_scenario())
+    last_com = robot_last_com(built.station.scene)
+    systems = {s.get_name(): s for s in built.diagram.GetSystems()}
+    sensing = systems["station"].GetSubsystemByName("sensing")
+    controller = systems["standup_controller"].GetSubsystemByName("controller")
+    assert sensing._last_com is last_com
+    assert controller.model.kinematics.last_com is last_com
+    simulator = Simulator(built.diagram)
+    simulator.Initialize()
+    simulator.AdvanceTo(1.0)
+    last_com.hits = 0
+    simulator.AdvanceTo(1.4)
+    assert last_com.hits >= 20
+    context = simulator.get_context()
+    station_context = systems["station"].GetMyContextFromRoot(context)
+    plant = built.station.scene.plant
+    plant_context = plant.GetMyContextFromRoot(context)
+    com = systems["station"].GetOutputPort("com_W").Eval(station_context)
+    drake_com = plant.CalcCenterOfMassPositionInWorld(
+        plant_context, [built.station.robot.model_instance]
+    )
+    assert abs(com - drake_com).max() < 1e-12
