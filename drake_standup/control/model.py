@@ -135,6 +135,7 @@ class ControllerModel:
         specs: list[ContactSpec],
         config: ControllerConfig,
         period_s: float,
+        *,
         dynamics=None,
         last_com=None,
     ):

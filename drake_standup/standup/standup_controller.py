@@ -133,15 +133,10 @@ def make_standup_controller(
         station.arm_joints,
         braced_drop_m=station.braced_drop_m,
     )
-    model = ControllerModel(
-        plant,
-        robot,
-        specs,
-        config,
-        period_s,
-        robot_dynamics(station.scene) if config.model_library == "pinocchio" else None,
-        robot_last_com(station.scene),
-    )
+    shared = {"last_com": robot_last_com(station.scene)}  # the sensed CoM's, per state
+    if config.model_library == "pinocchio":
+        shared = {"dynamics": robot_dynamics(station.scene)}
+    model = ControllerModel(plant, robot, specs, config, period_s, **shared)
     systems = {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()

@@ -163,6 +163,7 @@ class RobotSensing(LeafSystem):
         thigh_points: dict[str, np.ndarray] | None = None,
         standing: StandingSupport | None = None,
         braced: StandingSupport | None = None,
+        *,
         dynamics=None,
         last_com: LastCoM | None = None,
     ):

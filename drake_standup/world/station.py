@@ -244,8 +244,10 @@ def _add_sensing(
             standing,
             braced,
             # The CoM from the controller model's pass, where Pinocchio computes it.
-            robot_dynamics(scene) if scenario.controller.model_library == "pinocchio" else None,
-            robot_last_com(scene),
+            dynamics=(
+                robot_dynamics(scene) if scenario.controller.model_library == "pinocchio" else None
+            ),
+            last_com=robot_last_com(scene),
         ),
     )
     robot_state = plant.get_state_output_port(robot.model_instance)
