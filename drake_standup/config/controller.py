@@ -191,6 +191,6 @@ class ControllerConfig:
     # QP solver: daqp (the fastest here, exact equalities), or Drake's osqp / clarabel.
     qp_solver: str = "daqp"
     # What computes the controller's model: Drake's plant itself, or pinocchio (one pass
-    # of the same tree, shared with the sensed CoM; `pip install .[pinocchio]`). Drake:
+    # of the same tree; `pip install .[pinocchio]`). Drake:
     # Pinocchio's pass measured no faster in the loop (docs/decisions/015-...).
     model_library: str = "drake"

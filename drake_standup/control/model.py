@@ -11,7 +11,6 @@ follows the robot's weighing while seated (control/mass.py).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
@@ -136,27 +135,25 @@ class ControllerModel:
         config: ControllerConfig,
         period_s: float,
         *,
-        dynamics=None,
         last_com=None,
     ):
-        """dynamics: the robot's Pinocchio pass to share (world/scene.py robot_dynamics),
-        with controller.model_library pinocchio; last_com: where Drake's model puts each
-        state's CoM for the sensing (robot_last_com)."""
+        """last_com: where the model puts each state's CoM for the sensing
+        (world/scene.py robot_last_com)."""
         if [spec.frame for spec in specs] != list(CONTACTS):
             raise ValueError(f"contact specs must be {CONTACTS}")
         self.specs = specs
-        library = partial(RobotKinematics, last_com=last_com)
+        library = RobotKinematics
         if config.model_library == "pinocchio":  # an optional package: imported if asked
             from drake_standup.control.pinocchio_terms import PinocchioKinematics
 
-            pinocchio = {} if dynamics is None else {"dynamics": dynamics}
-            library = partial(PinocchioKinematics, **pinocchio)
+            library = PinocchioKinematics
         self.kinematics = library(
             plant,
             robot,
             held_frames=[spec.frame for spec in specs if spec.constrained],
             other_frames=[spec.frame for spec in specs if not spec.constrained] + list(HANDS),
             hold_points_m={spec.frame: spec.hold_point_m for spec in specs},
+            last_com=last_com,
         )
         g = -plant.gravity_field().gravity_vector()[2]
         filter_s = config.mass_estimation_filter_s

@@ -14,21 +14,12 @@ _HOLD = "@hold"  # an operational frame at a held frame's hold point
 
 class PinocchioKinematics(RobotKinematics):
     """RobotKinematics whose pass is Pinocchio's (robot/dynamics.py): the same terms to
-    round-off. dynamics: a RobotDynamics of the same robot to share (the sensed CoM's);
-    None: one of its own."""
+    round-off."""
 
-    def __init__(
-        self,
-        plant: MultibodyPlant,
-        robot: Robot,
-        *args,
-        dynamics: RobotDynamics | None = None,
-        **kwargs,
-    ):
+    def __init__(self, plant: MultibodyPlant, robot: Robot, *args, **kwargs):
         super().__init__(plant, robot, *args, **kwargs)
-        if dynamics is None:
-            base = plant.GetBodyByName(BASE_BODY, robot.model_instance)
-            dynamics = RobotDynamics.of(plant, robot.model_instance, base)
+        base = plant.GetBodyByName(BASE_BODY, robot.model_instance)
+        dynamics = RobotDynamics.of(plant, robot.model_instance, base)
         for name, (frame, p_FP) in self._frames.items():
             dynamics.tree.add_frame(name, frame)
             if p_FP is not None:
@@ -83,6 +74,4 @@ class PinocchioKinematics(RobotKinematics):
 
     def frame_rotations(self, q: np.ndarray, frame_names: list[str]) -> np.ndarray:
         """R_WF (k, 3, 3) of the named frames at the positions q."""
-        q_pin = q.take(self.dynamics.tree.q_take)
-        q_pin[3:7] /= np.sqrt(q_pin[3:7] @ q_pin[3:7])
-        return self.dynamics.rotations(q_pin, frame_names)
+        return self.dynamics.rotations(self.dynamics.positions(q), frame_names)

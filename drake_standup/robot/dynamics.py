@@ -2,11 +2,11 @@
 
 The simulated plant stays Drake's; this is the same tree, built from the plant itself
 (each body's spatial inertia, each joint's frames and axis, each actuator's reflected
-inertia), so it is the same URDF, reduced the same way, with the same inertias. The
-controller's model (control/pinocchio_terms.py) and the CoM the robot senses
-(world/sensing.py) share one pass a state (RobotDynamics). tests/control/
-test_pinocchio_terms.py checks every term against Drake's on random states of every
-supported icub-models robot. Why Pinocchio: docs/decisions/015-controller-model-library.md.
+inertia), so it is the same URDF, reduced the same way, with the same inertias; the
+controller's model (control/pinocchio_terms.py) computes its terms from one pass a state
+(RobotDynamics). tests/control/test_pinocchio_terms.py checks every term against
+Drake's on random states of every supported icub-models robot. Why Pinocchio (an
+option): docs/decisions/015-controller-model-library.md.
 
 Conventions. Drake's floating base (QuaternionFloatingJoint) has q = [quaternion wxyz;
 p_WBo] and v = [w_WB; v_WBo], both in W. Pinocchio's free-flyer has q = [p_WBo;
@@ -154,10 +154,7 @@ class PinocchioTree:
 
 class RobotDynamics:
     """One pass of Pinocchio at a Drake state x = [q; v], its results in Drake's
-    conventions (the module docstring): nominal masses, no damping. The last state's pass
-    is kept, so every reader of one state (the controller's model, the sensed CoM) shares
-    it; its data then hold that state's placements, velocities, bias accelerations and
-    joint Jacobians."""
+    conventions (the module docstring): nominal masses, no damping."""
 
     def __init__(self, tree: PinocchioTree, nq: int, gravity_W: np.ndarray):
         self.tree, self.nq = tree, nq
@@ -175,8 +172,6 @@ class RobotDynamics:
         self._gravity_W = np.asarray(gravity_W, dtype=float)
         self._frames_count = -1  # the data are made anew once frames were added
         self.data = self._pose_data = None
-        self._last: tuple[bytes, tuple] | None = None
-        self.passes = 0  # how many states were computed (the sharing's test reads it)
 
     @classmethod
     def of(cls, plant: MultibodyPlant, instance, base_body) -> RobotDynamics:
@@ -192,27 +187,20 @@ class RobotDynamics:
             self.data = self.tree.model.createData()
             self._pose_data = self.tree.model.createData()
             self._frames_count = len(self.tree.frame_ids)
-            self._last = None
         return self.data
 
-    def run(self, x: np.ndarray) -> tuple:
-        """(diag(R_WB, R_WB), M, C v - tau_g, q_pin) at x; M and h are the caller's to
-        change (the kept pass holds its own)."""
-        key = x.tobytes()
-        if self._last is not None and self._last[0] == key:
-            R2, M, h, q_pin = self._last[1]
-            return R2, M.copy(), h.copy(), q_pin
-        result = self._run(x)
-        self._last = key, result
-        R2, M, h, q_pin = result
-        return R2, M.copy(), h.copy(), q_pin
+    def positions(self, q: np.ndarray) -> np.ndarray:
+        """Pinocchio's q of Drake's q (or x = [q; v]), its quaternion made unit."""
+        q_pin = q.take(self.tree.q_take)
+        q_pin[3:7] *= 1.0 / math.sqrt(q_pin[3:7] @ q_pin[3:7])
+        return q_pin
 
-    def _run(self, x: np.ndarray) -> tuple:
+    def run(self, x: np.ndarray) -> tuple:
+        """(diag(R_WB, R_WB), M, C v - tau_g, q_pin) at x; the data then hold x's
+        placements, velocities, bias accelerations and joint Jacobians."""
         tree = self.tree
         data, model = self._data(), tree.model
-        self.passes += 1
-        q_pin = x.take(tree.q_take)
-        q_pin[3:7] *= 1.0 / math.sqrt(q_pin[3:7] @ q_pin[3:7])
+        q_pin = self.positions(x)
         pin.crba(model, data, q_pin, pin.Convention.WORLD)  # M, and every joint's Jacobian
         R = data.oMi[1].rotation  # R_WB
         v_pin = x.take(self._v_take)
@@ -224,7 +212,7 @@ class RobotDynamics:
         a_pin[:3] = -cross(v_pin[3:6], v_pin[:3])
         h = pin.rnea(model, data, q_pin, v_pin, a_pin).take(self._perm)
         pin.forwardKinematics(model, data, q_pin, v_pin, a_pin)  # rnea leaves data.a
-        R2 = self._R2.copy()
+        R2 = self._R2
         R2[:3, :3] = R2[3:, 3:] = R
         # T's base blocks: rows and columns 0:3 and 3:6 each by R.
         M[:6] = R2 @ M[:6]
@@ -232,14 +220,6 @@ class RobotDynamics:
         h[:6] = R2 @ h[:6]
         h -= self._gravity_W @ M[3:6]  # -tau_g: J_com = M[3:6] / m (control/terms.py)
         return R2, M, h, q_pin
-
-    def com(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(p_WCom, v_WCom) at x, from the pass's M: its base rows are the momentum's
-        (control/terms.py's shortcuts)."""
-        _, M, _, _ = self.run(x)
-        mass = self.tree.mass_kg
-        p_BoCom = np.array([M[2, 4], M[0, 5], M[1, 3]]) / mass  # M[0:3, 3:6] = m [p]x
-        return x[4:7] + p_BoCom, M[3:6] @ x[self.nq :] / mass
 
     def jacobians(self, R2: np.ndarray, names, world: bool = False) -> np.ndarray:
         """(k, 6, nv) [w; v] of the named frames, expressed in each frame (world: in W,

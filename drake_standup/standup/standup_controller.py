@@ -47,7 +47,7 @@ from drake_standup.standup.plan import StandupPlan
 from drake_standup.standup.state_machine import StandupStateMachine
 from drake_standup.standup.task_references import PhaseReferences, TaskReferenceGenerator
 from drake_standup.standup.whole_body import StandupWholeBodyController
-from drake_standup.world.scene import robot_dynamics, robot_last_com
+from drake_standup.world.scene import robot_last_com
 from drake_standup.world.sensing import standing_lean
 from drake_standup.world.station import Station
 
@@ -133,10 +133,9 @@ def make_standup_controller(
         station.arm_joints,
         braced_drop_m=station.braced_drop_m,
     )
-    shared = {"last_com": robot_last_com(station.scene)}  # the sensed CoM's, per state
-    if config.model_library == "pinocchio":
-        shared = {"dynamics": robot_dynamics(station.scene)}
-    model = ControllerModel(plant, robot, specs, config, period_s, **shared)
+    model = ControllerModel(
+        plant, robot, specs, config, period_s, last_com=robot_last_com(station.scene)
+    )
     systems = {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()

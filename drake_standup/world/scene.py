@@ -18,7 +18,7 @@ from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.systems.framework import Context, DiagramBuilder
 
 from drake_standup.config import Scenario, ScenarioError, chair_file
-from drake_standup.config.inputs import BASE_LINK, add_sdf
+from drake_standup.config.inputs import add_sdf
 from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.helper.body import GRIPS, HelperBody, add_helper_body
@@ -54,8 +54,6 @@ class Scene:
     alone: Scene | None = None
     # The robot standing in a posture, each posture's numbers worked out once (add_scene).
     standing: StandingGeometry | None = None
-    # The robot's dynamics by Pinocchio, shared by every reader of a state (robot_dynamics).
-    dynamics: object | None = None
     # The controller's model's CoM of the last state, for the sensing (robot_last_com).
     last_com: LastCoM | None = None
 
@@ -186,21 +184,8 @@ def add_scene(
     return scene
 
 
-def robot_dynamics(scene: Scene):
-    """The robot's RobotDynamics (robot/dynamics.py), one per scene: the sensed CoM and
-    the controller's model read one pass a state. Built from the robot's own plant
-    (scene.alone with a helper's body: the same tree)."""
-    from drake_standup.robot.dynamics import RobotDynamics  # pinocchio is optional
-
-    own = scene.alone or scene
-    if own.dynamics is None:
-        base = own.plant.GetBodyByName(BASE_LINK, own.robot.model_instance)
-        own.dynamics = RobotDynamics.of(own.plant, own.robot.model_instance, base)
-    return own.dynamics
-
-
 def robot_last_com(scene: Scene) -> LastCoM:
-    """The robot's LastCoM (robot/last_com.py), one per scene: the controller's Drake model
+    """The robot's LastCoM (robot/last_com.py), one per scene: the controller's model
     puts each state's CoM, the sensing reads it."""
     own = scene.alone or scene
     if own.last_com is None:

@@ -164,14 +164,12 @@ class RobotSensing(LeafSystem):
         standing: StandingSupport | None = None,
         braced: StandingSupport | None = None,
         *,
-        dynamics=None,
         last_com: LastCoM | None = None,
     ):
-        """dynamics: a RobotDynamics (robot/dynamics.py), the CoM from the pass the
-        controller's model shares; last_com: the controller's model's CoM of the state,
-        where it computed it (robot/last_com.py); else from Drake's plant."""
+        """last_com: the controller's model's CoM of the state, where it computed it
+        (robot/last_com.py); else from Drake's plant."""
         super().__init__()
-        self._dynamics, self._last_com = dynamics, last_com
+        self._last_com = last_com
         self._plant = plant
         self._instance = robot.model_instance
         self._context = plant.CreateDefaultContext()
@@ -240,8 +238,6 @@ class RobotSensing(LeafSystem):
             self._context_state = state
 
     def _calc_kinematics(self, context: Context) -> tuple[np.ndarray, np.ndarray]:
-        if self._dynamics is not None:
-            return self._dynamics.com(self._state.Eval(context))
         if self._last_com is not None:
             com = self._last_com.get(self._state.Eval(context))
             if com is not None:

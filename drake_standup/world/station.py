@@ -44,7 +44,6 @@ from drake_standup.world.scene import (
     Scene,
     add_scene,
     check_com_heights,
-    robot_dynamics,
     robot_last_com,
 )
 from drake_standup.world.sensing import (
@@ -243,10 +242,6 @@ def _add_sensing(
             thigh_points(robot),
             standing,
             braced,
-            # The CoM from the controller model's pass, where Pinocchio computes it.
-            dynamics=(
-                robot_dynamics(scene) if scenario.controller.model_library == "pinocchio" else None
-            ),
             last_com=robot_last_com(scene),
         ),
     )
