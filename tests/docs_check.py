@@ -148,6 +148,7 @@ _SECTIONS = {
     "perturbation",
     "visualization",
     "seat_hold",
+    "hardware",
 }
 _PLACEHOLDERS = {"NAME", "nope", "a/b.py", "dir/file.py", "docs/x.md"}
 
@@ -193,7 +194,7 @@ def _defined(path: Path) -> dict[str, set[str]]:
 
 
 # Module names more than one file of the package has, and __init__: not resolvable by name.
-_AMBIGUOUS = {"__init__", "__main__", "cli", "controller", "body", "chair", "figures"}
+_AMBIGUOUS = {"__init__", "__main__", "cli", "controller", "body", "chair", "figures", "hardware"}
 
 
 def missing_names(

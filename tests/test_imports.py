@@ -120,6 +120,7 @@ LAYERS = (
     "robot",
     "helper",
     "world",
+    "senses",
     "control",
     "standup",
     "outputs",

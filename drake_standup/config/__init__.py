@@ -13,6 +13,7 @@ errors.py      ScenarioError: one line naming the key or file
 from drake_standup.config.chair import ChairConfig, InitialPose, chair_file
 from drake_standup.config.controller import MODEL_LIBRARIES, QP_SOLVERS, ControllerConfig
 from drake_standup.config.errors import ScenarioError
+from drake_standup.config.hardware import HARDWARE, HardwareConfig
 from drake_standup.config.inputs import check_output_dir, read_text_file
 from drake_standup.config.loading import (
     apply_overrides,
@@ -20,7 +21,7 @@ from drake_standup.config.loading import (
     load_scenario,
     parse_scenario,
 )
-from drake_standup.config.rules import JOINT_TABLES, RULES, Range, validate
+from drake_standup.config.rules import JOINT_TABLES, RULES, Range, validate, with_hardware
 from drake_standup.config.scenario import (
     DEFAULT_SCENARIO,
     EFFORT_LIMIT_NM,
@@ -55,6 +56,8 @@ __all__ = [
     "ComplianceConfig",
     "ControllerConfig",
     "FallConfig",
+    "HardwareConfig",
+    "HARDWARE",
     "HumanConfig",
     "InitialPose",
     "PerturbationConfig",
@@ -76,4 +79,5 @@ __all__ = [
     "parse_scenario",
     "read_text_file",
     "validate",
+    "with_hardware",
 ]

@@ -20,7 +20,7 @@ from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import read_text_file
 from drake_standup.config.legacy import read_legacy
 from drake_standup.config.resources import find, shipped
-from drake_standup.config.rules import _format, _nodes, _pattern, validate
+from drake_standup.config.rules import _format, _nodes, _pattern, validate, with_hardware
 from drake_standup.config.scenario import DEFAULT_SCENARIO, Scenario
 
 
@@ -59,7 +59,7 @@ def apply_overrides(scenario: Scenario, overrides: Iterable) -> Scenario:
     for path, value in overrides:
         top = _set(data, path, value)
         layer[top] = data[top]
-    return validate(_load(layer, scenario))
+    return validate(with_hardware(_load(layer, scenario)))
 
 
 def expand_key_path(scenario: Scenario, path: str) -> list[str]:

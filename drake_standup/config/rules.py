@@ -6,6 +6,7 @@ RULES, the checks across fields, the robot model's names and the chair file
 (config/inputs.py); every message is one line naming the key path and what it accepts.
 """
 
+import copy
 import math
 import re
 from collections.abc import Iterator
@@ -19,6 +20,7 @@ from drake_standup.config.body import TONES
 from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig
 from drake_standup.config.controller import MODEL_LIBRARIES, QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
+from drake_standup.config.hardware import HARDWARE
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
 from drake_standup.config.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
 from drake_standup.config.scenario import REFLECTED_INERTIA, RESPONSES, Scenario
@@ -74,6 +76,12 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (("velocity", "path"), "human.reactive.guide"),
     (("tangent", "interaction"), "advancement.law"),
     (REFLECTED_INERTIA, "robot.reflected_inertia"),
+    (HARDWARE, "robot.hardware"),
+    # The robot's own rate: 25-1000 Hz (YARP ran the authors' at 100 Hz). Hz.
+    (Range(low=25.0, high=1000.0), "hardware.rate_hz"),
+    (Range(low=1.0, high=3.0, text="1, 2 or 3", integer=True), "hardware.delay_ticks"),
+    (Range(low=0.0, high=5.0), "hardware.*_scale"),
+    (PLANT_STEP, "hardware.plant_time_step_s"),
     (RESPONSES, "response"),
     (("hands", "time"), "standup.trigger"),
     (SEAT_HOLDS, "phases.*.seat_hold phases.*.seat_hold_sat_back"),
@@ -121,7 +129,8 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "controller.lean_max_* controller.mass_estimation_filter_s seat_hold.* "
         "fall.max_qp_failure_streak_s "
         "perturbation.pushes[*].start_s perturbation.hand_wrench_noise_N "
-        "perturbation.noise_seed plant.sap_near_rigid_threshold simulator.target_realtime_rate "
+        "perturbation.noise_seed hardware.seed plant.sap_near_rigid_threshold "
+        "simulator.target_realtime_rate "
         "simulator.start_time fall.min_root_height_m",
     ),
     (PLANT_STEP, "plant.time_step"),
@@ -283,6 +292,8 @@ def _check_across_fields(scenario: Scenario) -> None:
     # actuation input only at its own steps, so a faster controller is wasted work and a
     # period off the plant's grid jitters.
     step, period = scenario.plant.time_step, scenario.controller_period_s
+    if scenario.robot.hardware == "icub":
+        _check_hardware_rate(scenario)
     ratio = period / step
     if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
         raise ScenarioError(
@@ -314,6 +325,33 @@ def _check_across_fields(scenario: Scenario) -> None:
             f"human.reactive.lead_max_m: {reactive.lead_max_m}; accepted: a number >= "
             f"lead_min_m ({reactive.lead_min_m})"
         )
+
+
+def _check_hardware_rate(scenario: Scenario) -> None:
+    """Under robot.hardware: icub the robot's rate and plant step are hardware's
+    (with_hardware sets them when a scenario is loaded)."""
+    hardware = scenario.hardware
+    for key, value, wanted in (
+        ("controller_period_s", scenario.controller_period_s, 1.0 / hardware.rate_hz),
+        ("plant.time_step", scenario.plant.time_step, hardware.plant_time_step_s),
+    ):
+        if abs(value - wanted) > 1e-12:
+            raise ScenarioError(
+                f"{key}: {value}; accepted: {wanted:g} under robot.hardware: icub (set "
+                "hardware.rate_hz and hardware.plant_time_step_s instead)"
+            )
+
+
+def with_hardware(scenario: Scenario) -> Scenario:
+    """scenario with its rate and plant step the hardware's under robot.hardware: icub
+    (controller_period_s = 1 / hardware.rate_hz, plant.time_step =
+    hardware.plant_time_step_s); under ideal, scenario itself."""
+    if scenario.robot.hardware != "icub":
+        return scenario
+    scenario = copy.deepcopy(scenario)
+    scenario.controller_period_s = 1.0 / scenario.hardware.rate_hz
+    scenario.plant.time_step = scenario.hardware.plant_time_step_s
+    return scenario
 
 
 def _check_cushion(chair: ChairConfig) -> None:

@@ -12,6 +12,7 @@ from pydrake.systems.analysis import SimulatorConfig
 from drake_standup.config.body import BodyHelperConfig
 from drake_standup.config.chair import ChairConfig, InitialPose
 from drake_standup.config.controller import ControllerConfig
+from drake_standup.config.hardware import HardwareConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.config.resources import data_root
 
@@ -46,6 +47,10 @@ class RobotConfig:
     # ([authors-code]: on for the real robots, off in Gazebo); the convergence study found it
     # cheaper per step and converged at a larger step (docs/performance.md).
     reflected_inertia: str = "real_robots"
+    # What the robot knows and how its joints act (HARDWARE): ideal, the simulator's exact
+    # state and contact forces at controller_period_s and exact torques; icub, the real
+    # robot's senses and muscles at its own rate (HardwareConfig, drake_standup/senses).
+    hardware: str = "ideal"
 
 
 @dataclass
@@ -413,6 +418,8 @@ class Scenario:
     chair: ChairConfig = field(default_factory=ChairConfig)
     seat_hold: SeatHoldConfig = field(default_factory=SeatHoldConfig)
     fall: FallConfig = field(default_factory=FallConfig)
+    # The real robot's senses and muscles, under robot.hardware: icub.
+    hardware: HardwareConfig = field(default_factory=HardwareConfig)
     # Pushes, model errors and sensor noise (robustness sweeps).
     perturbation: PerturbationConfig = field(default_factory=PerturbationConfig)
     visualization: VisualizationConfig = field(default_factory=VisualizationConfig)

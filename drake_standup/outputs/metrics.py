@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from drake_standup.helper.work import HELPER_SPENT
+from drake_standup.outputs.estimation import estimation_metrics
 from drake_standup.outputs.signals import group_normal_forces
 from drake_standup.robot.limbs import JOINT_GROUPS, joint_group, shoulder_tendon_margin_rad
 
@@ -374,6 +375,7 @@ def run_metrics(
             signals["com_W"], signals["com_reference_W"]
         )
     metrics.update(limb_metrics(signals))
+    metrics.update(estimation_metrics(signals))
     torques = signals["joint_torques_Nm"]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None
     return metrics

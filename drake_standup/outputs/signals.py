@@ -122,7 +122,34 @@ def _station_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarr
             signals[name] = logs["helper_spent"][:, k]
     if "helper_torques_Nm" in logs:  # the helper's body (human.mode: body)
         signals |= _helper_body_signals(station, logs)
+    if "estimated_robot_state" in logs:  # robot.hardware: icub
+        signals |= _estimation_signals(station, logs)
     return signals
+
+
+def _estimation_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """What the robot estimated of itself (drake_standup/senses), beside the truth it
+    is judged on: the base, the joints, the CoM, the hands' wrenches, the pads' forces."""
+    nq = station.plant.num_positions(station.robot.model_instance)
+    joints = station.joints
+    state, estimate = logs["robot_state"], logs["estimated_robot_state"]
+    n = len(logs["time_s"])
+    return {
+        "base_velocity_W": state[:, nq : nq + 6],  # [w; v] of the base, its origin's
+        "estimated_base_quaternion_wxyz": estimate[:, 0:4],
+        "estimated_base_position_W": estimate[:, 4:7],
+        "estimated_base_velocity_W": estimate[:, nq : nq + 6],
+        "estimated_joint_positions_rad": estimate[:, joints.q_index],
+        "estimated_joint_velocities_rad_per_s": estimate[:, nq + joints.v_index],
+        "com_velocity_W": logs["com_velocity_W"],
+        "estimated_com_W": logs["estimated_com_W"],
+        "estimated_com_velocity_W": logs["estimated_com_velocity_W"],
+        "estimated_hand_wrenches_W": logs["estimated_hand_wrenches_W"],
+        "estimated_pad_forces_W": logs["estimated_pad_forces_W"].reshape(
+            n, len(station.pad_groups), 3
+        ),
+        "imu_attitude_wxyz": logs["imu_attitude_W"],
+    }
 
 
 def _helper_body_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

@@ -22,6 +22,7 @@ from drake_standup.helper.body_control import make_body_helper
 from drake_standup.helper.hands import HumanWrenchSource
 from drake_standup.helper.work import HelperWork
 from drake_standup.robot.icub import actuated_joints
+from drake_standup.senses.wiring import add_muscles, add_senses
 from drake_standup.sim.visuals import StandupVisuals
 from drake_standup.standup.plan import StandupPlan, feet_reach, make_plan
 from drake_standup.standup.standup_controller import StandupController, make_standup_controller
@@ -198,14 +199,32 @@ def _add_standup_controller(
         response = ConstantVectorSource([float(RESPONSES.index(scenario.response))])
         outputs["response"] = builder.AddNamedSystem("response", response).get_output_port()
     builder.Connect(outputs["response"], brain.GetInputPort("response"))
+    # What the controller reads: the station's truth (ideal) or the robot's own senses.
+    senses = None
+    if scenario.robot.hardware == "icub":
+        senses = add_senses(builder, station, scenario, world)
+        outputs |= senses.estimates
+        outputs["com_velocity_W"] = world.GetOutputPort("com_velocity_W")
     for i in range(brain.num_input_ports()):
         port = brain.get_input_port(i)
-        if port.get_name() == "stand_up":
+        name = port.get_name()
+        if name == "stand_up":
             if human.HasOutputPort("stand_up"):
                 builder.Connect(human.GetOutputPort("stand_up"), port)
-        elif port.get_name() != "response":
-            builder.Connect(world.GetOutputPort(port.get_name()), port)
-    builder.Connect(brain.GetOutputPort("actuation"), world.GetInputPort("actuation"))
+        elif name != "response":
+            source = senses.controller_inputs[name] if senses else world.GetOutputPort(name)
+            builder.Connect(source, port)
+    if senses is None:
+        builder.Connect(brain.GetOutputPort("actuation"), world.GetInputPort("actuation"))
+    else:
+        add_muscles(
+            builder,
+            station,
+            scenario,
+            world,
+            command=brain.GetOutputPort("actuation"),
+            estimated_state=senses.controller_inputs["robot_state"],
+        )
     outputs |= {name: brain.GetOutputPort(name) for name in CONTROLLER_SIGNALS}
     return standup
 

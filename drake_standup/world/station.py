@@ -124,6 +124,8 @@ def make_station(
     builder.ExportOutput(reporter.get_output_port(), "pad_forces_W")
     if scene.helper is not None:
         _export_helper_ports(builder, plant, scene.helper.person.model_instance)
+    if scenario.robot.hardware == "icub":
+        _export_sensor_ports(builder, plant)
     diagram = builder.Build()
     diagram.set_name("station")
     joints = actuated_joints(plant, instance)
@@ -141,6 +143,19 @@ def _export_helper_ports(builder: DiagramBuilder, plant: MultibodyPlant, person)
     builder.ExportOutput(plant.get_net_actuation_output_port(person), "helper_torques_Nm")
 
 
+def _export_sensor_ports(builder: DiagramBuilder, plant: MultibodyPlant) -> None:
+    """What the robot's own sensors read of the plant (robot.hardware: icub,
+    drake_standup/senses): the joints' reaction forces (the F/T sensors), the bodies'
+    poses, velocities and accelerations (the IMU), and the joints' friction's input."""
+    builder.ExportOutput(plant.get_reaction_forces_output_port(), "reaction_forces")
+    builder.ExportOutput(plant.get_body_poses_output_port(), "body_poses")
+    builder.ExportOutput(plant.get_body_spatial_velocities_output_port(), "body_spatial_velocities")
+    builder.ExportOutput(
+        plant.get_body_spatial_accelerations_output_port(), "body_spatial_accelerations"
+    )
+    builder.ExportInput(plant.get_applied_generalized_force_input_port(), "generalized_friction")
+
+
 def _add_pad_forces(
     builder: DiagramBuilder, plant: MultibodyPlant, robot: Robot
 ) -> tuple[dict[str, str], ContactForceReporter]:
@@ -156,20 +171,24 @@ def _add_pad_forces(
         "contact_forces", ContactForceReporter(pads, [robot.contact_geometries[n] for n in pads])
     )
     builder.Connect(plant.get_contact_results_output_port(), reporter.get_input_port())
-    # Leg force sensors: the seat pads' normal forces, and the vertical force on all pads
-    # (the robot's weight while it sits still).
+    for name, gain in pad_load_gains(robot, pads).items():
+        system = builder.AddNamedSystem(name, MatrixGain(gain))
+        builder.Connect(reporter.get_output_port(), system.get_input_port())
+        builder.ExportOutput(system.get_output_port(), name)
+    return pad_groups, reporter
+
+
+def pad_load_gains(robot: Robot, pads: list[str]) -> dict[str, np.ndarray]:
+    """The leg force sensors as gains on pad_forces_W (pads: the pads' names in its
+    order): the seat pads' normal forces (SEAT_PAD_FRAMES), and the vertical force on all
+    pads (the robot's weight while it sits still)."""
     by_frame = {shape.frame: shape.name for shape in robot.contact_shapes}
     seat = np.zeros((len(SEAT_PAD_FRAMES), 3 * len(pads)))
     for row, task in enumerate(SEAT_PAD_FRAMES):
         seat[row, 3 * pads.index(by_frame[robot.TASK_FRAMES[task]]) + 2] = 1.0
     total = np.zeros((1, 3 * len(pads)))
     total[0, 2::3] = 1.0
-    gains = {"seat_pad_normal_forces_N": seat, "pads_vertical_force_N": total}
-    for name, gain in gains.items():
-        system = builder.AddNamedSystem(name, MatrixGain(gain))
-        builder.Connect(reporter.get_output_port(), system.get_input_port())
-        builder.ExportOutput(system.get_output_port(), name)
-    return pad_groups, reporter
+    return {"seat_pad_normal_forces_N": seat, "pads_vertical_force_N": total}
 
 
 def _add_pushes_and_hand_sensors(

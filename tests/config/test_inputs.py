@@ -134,7 +134,7 @@ BAD = {
         "scenario list.yaml: [1, 2]; accepted: a mapping of robot, duration_s, plant, "
         "simulator, human, response, compliance, advancement, standup, phases, controller, "
         "controller_period_s, "
-        "initial, chair, seat_hold, fall, perturbation, visualization, log_period_s",
+        "initial, chair, seat_hold, fall, hardware, perturbation, visualization, log_period_s",
     ),
     "response_unknown": (
         {},

@@ -1,0 +1,261 @@
+"""RobotEstimator: what the robot knows of itself, from its sensors alone (robot.hardware: icub).
+
+Once a tick, from the encoders, the waist IMU and the six F/T sensors (sensors.py):
+
+    joints      positions as the joints' absolute encoders read them; velocities as the
+                motor boards give them (sensors.py: the motor encoders' count rate)
+    attitude    the IMU's: the gyroscope integrated, pulled toward the accelerometer's
+                gravity with time constant attitude_time_constant_s (complementary)
+    base        legged odometry, as robotology's base estimator: the supporting sole stays
+                where it was when it took the load, so the base pose is the sole's pose
+                less the legs' kinematics; its tilt blended with the IMU's by their
+                variances (encoders' resolution along the leg against the attitude
+                filter's bias); the angular velocity the gyroscope's; the linear one the
+                sole's standing still
+    wrenches    each piece's external wrench (subtrees.py) from the F/T sensors less the
+                piece's own dynamics at the estimated state and the base's filtered acceleration:
+                the hands' wrenches and each pad's force (wholeBodyDynamics' idea); a
+                hand's wrench is zero until its contact is made (_hand_contacts), so the
+                advancement reads the estimate's error with nobody pulling as no pull
+
+Outputs (state outputs: what one tick computed is what the controller reads at the next):
+robot_state (the estimate, [q; v] as the plant's), hand_wrenches_W (12,
+payloads.HAND_WRENCHES), pad_forces_W (3 a pad, the station's pad order), imu_attitude_W (4,
+the attitude filter's quaternion of the base, for the figures).
+The estimator starts from the robot's known seated pose (its world frame set at its feet).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydrake.common.eigen_geometry import Quaternion
+from pydrake.math import RotationMatrix
+from pydrake.multibody.tree import JacobianWrtVariable
+from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
+
+from drake_standup.robot.spatial import cross
+from drake_standup.senses.hardware import FT_JOINTS, IMU_FRAME, ICubHardware
+from drake_standup.senses.subtrees import RobotPieces, wrench_at
+
+_HANDS = ("l_hand", "r_hand")
+_SOLES = ("l_sole", "r_sole")
+
+
+def rotation_vector(R: np.ndarray) -> np.ndarray:
+    """The axis-angle vector of rotation matrix R (log map)."""
+    c = max(-1.0, min(1.0, (np.trace(R) - 1.0) / 2.0))
+    angle = math.acos(c)
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    if angle < 1e-9:
+        return w / 2.0
+    return w * (angle / (2.0 * math.sin(angle)))
+
+
+def exp_rotation(w: np.ndarray) -> np.ndarray:
+    """The rotation matrix of axis-angle vector w (Rodrigues)."""
+    angle = float(np.linalg.norm(w))
+    if angle < 1e-12:
+        return np.eye(3)
+    k = w / angle
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * K @ K
+
+
+def first_order_gain(cutoff_hz: float, period_s: float) -> float:
+    """The discrete first-order filter's gain a (y += a (u - y)) for cutoff_hz at period_s."""
+    return 1.0 - math.exp(-2.0 * math.pi * cutoff_hz * period_s)
+
+
+class RobotEstimator(LeafSystem):
+    """The module docstring's system, every hw.period_s."""
+
+    def __init__(self, plant, robot, hw: ICubHardware, x0: np.ndarray, pads: list[str]):
+        """plant: the robot's own model (the controller's); x0: its seated state; pads: the
+        pads' frames in the station's pad order."""
+        super().__init__()
+        self._plant, self._hw = plant, hw
+        self._instance = robot.model_instance
+        self._context = plant.CreateDefaultContext()
+        self._nq = plant.num_positions(self._instance)
+        self._nv = plant.num_velocities(self._instance)
+        self._nj = self._nq - 7
+        self._pieces = RobotPieces(plant, self._instance, list(FT_JOINTS))
+        self._hands = [robot.frame(plant, h) for h in _HANDS]
+        self._soles = [robot.frame(plant, s) for s in _SOLES]
+        self._root = plant.GetBodyByName("root_link", self._instance)
+        self._imu_frame = plant.GetFrameByName(IMU_FRAME, self._instance)
+        self._v_start = _robot_v_start(plant, self._instance)
+        self._pad_piece = [
+            self._pieces.piece_of(plant.GetFrameByName(f, self._instance).body().name())
+            for f in pads
+        ]
+        self._hand_piece = [self._pieces.piece_of(f.body().name()) for f in self._hands]
+        self._a_a = first_order_gain(hw.acceleration_filter_hz, hw.period_s)
+        self._tilt_weight = _tilt_weight(hw)
+        x0 = np.asarray(x0, dtype=float)
+        plant.SetPositionsAndVelocities(self._context, self._instance, x0)
+        X_WF = self._soles[0].CalcPoseInWorld(self._context)
+        n_pads = len(pads)
+        self._x = self.DeclareDiscreteState(x0)
+        # [started, anchor sole (0 left, 1 right), anchor's p (3) and quaternion (4)]
+        anchor = np.r_[0.0, 0.0, X_WF.translation(), X_WF.rotation().ToQuaternion().wxyz()]
+        self._anchor = self.DeclareDiscreteState(anchor)
+        self._vdot = self._declare(self._nv)
+        # The attitude filter's R_WS, the IMU frame's (its first: the seated pose's).
+        R_WS = self._imu_frame.CalcPoseInWorld(self._context).rotation()
+        self._attitude = self.DeclareDiscreteState(R_WS.ToQuaternion().wxyz())
+        self._hands_state = self._declare(12)
+        self._touch = self._declare(4)
+        self._pads_state = self._declare(3 * n_pads)
+        self._encoders = self.DeclareVectorInputPort("encoder_positions", self._nj)
+        self._velocities = self.DeclareVectorInputPort("encoder_velocities", self._nj)
+        self._imu = self.DeclareVectorInputPort("imu", 6)
+        self._ft = self.DeclareVectorInputPort("ft_wrenches", 36)
+        self.DeclareStateOutputPort("robot_state", self._x)
+        self.DeclareStateOutputPort("hand_wrenches_W", self._hands_state)
+        self.DeclareStateOutputPort("pad_forces_W", self._pads_state)
+        self.DeclareStateOutputPort("imu_attitude_W", self._attitude)
+        self.DeclarePeriodicDiscreteUpdateEvent(hw.period_s, 0.0, self._Update)
+
+    def _declare(self, n: int):
+        return self.DeclareDiscreteState(np.zeros(n))
+
+    def _Update(self, context: Context, out: DiscreteValues) -> None:
+        T = self._hw.period_s
+        get = context.get_discrete_state
+        x_prev = get(self._x).value()
+        anchor = get(self._anchor).value().copy()
+        q_j = self._encoders.Eval(context)
+        imu = self._imu.Eval(context)
+        started = anchor[0] > 0.5
+        v_prev = x_prev[self._nq :]
+        v_j = self._velocities.Eval(context)
+        R_WS = self._attitude_step(get(self._attitude).value(), imu, T)
+        R_WB, p_WB, R_BS = self._base_pose(q_j, R_WS, anchor)
+        w_W, v_Bo = self._base_velocity(R_WB, p_WB, q_j, R_BS @ imu[:3], v_j, int(anchor[1]))
+        v = np.r_[w_W, v_Bo, v_j]
+        vdot_prev = get(self._vdot).value()
+        vdot = vdot_prev + self._a_a * ((v - v_prev) / T - vdot_prev) if started else vdot_prev
+        x = np.r_[RotationMatrix(R_WB).ToQuaternion().wxyz(), p_WB, q_j, v]
+        self._plant.SetPositionsAndVelocities(self._context, self._instance, x)
+        wrenches = self._pieces.external_wrenches(self._context, vdot, self._ft.Eval(context))
+        pads = np.concatenate([wrenches[k, 3:] for k in self._pad_piece])
+        hands = np.concatenate(
+            [
+                wrench_at(wrenches[k], frame.CalcPoseInWorld(self._context).translation())
+                for k, frame in zip(self._hand_piece, self._hands, strict=True)
+            ]
+        )
+        touch = self._hand_contacts(get(self._touch).value(), hands)
+        hands = hands * np.repeat(touch[:2], 6)
+        anchor[0] = 1.0
+        self._switch_anchor(anchor, wrenches)
+        out.set_value(self._touch, touch)
+        out.set_value(self._x, x)
+        out.set_value(self._anchor, anchor)
+        out.set_value(self._vdot, vdot)
+        out.set_value(self._attitude, RotationMatrix(R_WS).ToQuaternion().wxyz())
+        out.set_value(self._hands_state, hands)
+        out.set_value(self._pads_state, pads)
+
+    def _hand_contacts(self, touch: np.ndarray, hands: np.ndarray) -> np.ndarray:
+        """Each hand's contact, a Schmitt trigger on its estimated force (as robotology's
+        estimators detect the feet's): made once the force stays above
+        hand_contact_make_N for hand_contact_time_s, broken once it stays below
+        hand_contact_break_N as long; touch: [contact (2), time past the threshold (2)]."""
+        hw, T = self._hw, self._hw.period_s
+        touch = touch.copy()
+        for i in range(2):
+            force = float(np.linalg.norm(hands[6 * i + 3 : 6 * i + 6]))
+            crossing = (
+                force < hw.hand_contact_break_N if touch[i] else force > hw.hand_contact_make_N
+            )
+            touch[2 + i] = touch[2 + i] + T if crossing else 0.0
+            if touch[2 + i] >= hw.hand_contact_time_s - 1e-9:
+                touch[i], touch[2 + i] = 1.0 - touch[i], 0.0
+        return touch
+
+    def _attitude_step(self, wxyz: np.ndarray, imu: np.ndarray, T: float) -> np.ndarray:
+        """The attitude filter's next R_WS: the gyroscope's rotation over T, then a turn of
+        T / time constant of the way toward the accelerometer's up."""
+        R = RotationMatrix(Quaternion(wxyz / np.linalg.norm(wxyz))).matrix()
+        R = R @ exp_rotation(imu[:3] * T)
+        up = R @ imu[3:]
+        norm = float(np.linalg.norm(up))
+        if norm > 0.0:
+            k = min(1.0, T / self._hw.attitude_time_constant_s)
+            R = exp_rotation(k * cross(up / norm, np.array([0.0, 0.0, 1.0]))) @ R
+        return R
+
+    def _base_pose(
+        self, q_j: np.ndarray, R_WS: np.ndarray, anchor: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The base's pose (R_WB, p_WB) from the anchored sole and the legs, its tilt blended
+        with the IMU's (module docstring); and R_BS, the IMU frame in the base."""
+        plant, c = self._plant, self._context
+        plant.SetPositions(c, self._instance, np.r_[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, q_j])
+        X_BF = self._soles[int(anchor[1])].CalcPoseInWorld(c)
+        R_BS = self._imu_frame.CalcPoseInWorld(c).rotation().matrix()
+        R_WF = RotationMatrix(Quaternion(anchor[5:9] / np.linalg.norm(anchor[5:9]))).matrix()
+        R_kin = R_WF @ X_BF.rotation().matrix().T
+        delta = rotation_vector(R_WS @ R_BS.T @ R_kin.T)
+        delta[2] = 0.0  # the yaw is the legs': the IMU's gyroscope drifts about gravity
+        R_WB = exp_rotation(self._tilt_weight * delta) @ R_kin
+        p_WB = anchor[2:5] - R_WB @ X_BF.translation()
+        return R_WB, p_WB, R_BS
+
+    def _base_velocity(
+        self, R_WB, p_WB, q_j, w_S_B: np.ndarray, v_j, sole: int
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The base's angular velocity (the gyroscope's, w_S_B in the base frame, less the
+        joints' share between base and IMU) and its origin's velocity that keeps the
+        anchored sole still, both in W."""
+        plant, c = self._plant, self._context
+        quat = RotationMatrix(R_WB).ToQuaternion().wxyz()
+        plant.SetPositions(c, self._instance, np.r_[quat, p_WB, q_j])
+        world = plant.world_frame()
+        start = self._v_start
+        J_imu = plant.CalcJacobianAngularVelocity(
+            c, JacobianWrtVariable.kV, self._imu_frame, world, world
+        )[:, start : start + self._nv]
+        w_W = R_WB @ w_S_B - J_imu[:, 6:] @ v_j
+        J = plant.CalcJacobianTranslationalVelocity(
+            c, JacobianWrtVariable.kV, self._soles[sole], np.zeros(3), world, world
+        )[:, start : start + self._nv]
+        return w_W, -(J[:, :3] @ w_W + J[:, 6:] @ v_j)
+
+    def _switch_anchor(self, anchor: np.ndarray, wrenches: np.ndarray) -> None:
+        """Moves the anchor to the other sole once it carries four times the anchored
+        sole's load (hysteresis: a foot that merely shares the load keeps it), latching
+        where that sole is now."""
+        loads = [wrenches[self._pieces.piece_of(f.body().name()), 5] for f in self._soles]
+        now = int(anchor[1])
+        other = 1 - now
+        if loads[other] > 4.0 * max(loads[now], 0.0) and loads[other] > 0.0:
+            X = self._soles[other].CalcPoseInWorld(self._context)
+            anchor[1] = other
+            anchor[2:5] = X.translation()
+            anchor[5:9] = X.rotation().ToQuaternion().wxyz()
+
+
+def _robot_v_start(plant, instance) -> int:
+    """Where the instance's velocities start in the plant's v."""
+    return min(
+        plant.get_joint(j).velocity_start()
+        for j in plant.GetJointIndices(instance)
+        if plant.get_joint(j).num_velocities() > 0
+    )
+
+
+def _tilt_weight(hw: ICubHardware) -> float:
+    """The IMU's share of the base's tilt, by inverse variances: the legs' tilt errs by
+    the encoders' quantization along the six joints from sole to base (uniform, step /
+    sqrt(12) each); the attitude filter's by the gyroscope's bias over its time constant
+    and the accelerometer's bias over g."""
+    step = 2.0 * math.pi / hw.encoder_counts
+    legs = math.sqrt(6.0) * step / math.sqrt(12.0)
+    imu = hw.gyro_bias_rad_s * hw.attitude_time_constant_s + hw.accel_bias_mps2 / 9.81
+    imu = max(imu, hw.gyro_noise_rad_s * math.sqrt(hw.attitude_time_constant_s * hw.period_s))
+    return legs**2 / (legs**2 + imu**2)

@@ -1,0 +1,139 @@
+"""The robot cut at its six F/T sensors, and each piece's external wrench.
+
+Cut at the F/T sensors, the iCub is seven pieces: the base (pelvis, torso, head,
+shoulders, hips), each arm below its sensor, each leg between its two sensors and each
+foot. A piece's Newton-Euler balance gives what acts on it from outside its sensors,
+
+    F_ext = sum_i [ c_i x m_i (a_ci - g) + I_i alpha_i + w_i x I_i w_i ; m_i (a_ci - g) ]
+            - sum_sensors (+-) F_sensor           (all about the world origin, in W)
+
+from the model, the estimated state and accelerations and the sensors' wrenches:
+the external-wrench estimation of robotology's wholeBodyDynamics with one unknown contact
+a piece (Nori et al. 2015, Sec. 3). A piece's contact is what touches it: the hand of an
+arm, the thigh pad of a leg, the sole of a foot, the buttocks of the base.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import Context
+
+from drake_standup.robot.spatial import cross
+
+
+@dataclass(frozen=True)
+class Piece:
+    """A piece of the robot: its bodies (indices into the pieces' body list) and its
+    sensors, each (sensor index, +1 if the piece is on the sensor's child side)."""
+
+    name: str
+    bodies: tuple[int, ...]
+    sensors: tuple[tuple[int, float], ...]
+
+
+class RobotPieces:
+    """The robot's pieces (module docstring) for plant's instance cut at ft_joints (weld
+    joints), with each body's mass, CoM and central inertia from the model."""
+
+    def __init__(self, plant: MultibodyPlant, instance, ft_joints: list[str]):
+        self._plant = plant
+        self._bodies = [plant.get_body(b) for b in plant.GetBodyIndices(instance)]
+        index = {body.index(): i for i, body in enumerate(self._bodies)}
+        joints = [plant.GetJointByName(name, instance) for name in ft_joints]
+        cut = {j.child_body().index(): k for k, j in enumerate(joints)}
+        # Each body's piece: the nearest sensor above it (its child side), or the base.
+        owner = []
+        for body in self._bodies:
+            b = body
+            while b.index() not in cut and _parent(plant, b) is not None:
+                b = _parent(plant, b)
+            owner.append(cut.get(b.index(), -1))
+        pieces = []
+        for k in [-1, *range(len(joints))]:
+            bodies = tuple(i for i, o in enumerate(owner) if o == k)
+            sensors = [(k, 1.0)] if k >= 0 else []
+            # The sensors below this piece: their parent body is in it.
+            for m, joint in enumerate(joints):
+                if index[joint.parent_body().index()] in bodies:
+                    sensors.append((m, -1.0))
+            name = "base" if k < 0 else ft_joints[k]
+            pieces.append(Piece(name, bodies, tuple(sensors)))
+        self.pieces = pieces
+        self._owner_piece = [[-1, *range(len(joints))].index(o) for o in owner]
+        self._mass = np.array([b.default_mass() for b in self._bodies])
+        self._com_B = np.array([b.default_com() for b in self._bodies])
+        self._inertia_B = np.array(
+            [
+                b.default_spatial_inertia()
+                .Shift(b.default_com())
+                .CalcRotationalInertia()
+                .CopyToFullMatrix3()
+                for b in self._bodies
+            ]
+        )
+        self._joints = joints
+        self._g = plant.gravity_field().gravity_vector()
+
+    def piece_of(self, body_name: str) -> int:
+        """The index of the piece holding the body body_name."""
+        names = [b.name() for b in self._bodies]
+        return self._owner_piece[names.index(body_name)]
+
+    def external_wrenches(
+        self, context: Context, vdot: np.ndarray, sensors: np.ndarray
+    ) -> np.ndarray:
+        """(n_pieces, 6) each piece's external wrench [torque; force] about the world origin,
+        in W, at the state in context (the estimate), the accelerations vdot and the sensors'
+        wrenches (36: [torque; force] on the child side at each joint's child frame, in it)."""
+        plant = self._plant
+        accelerations = plant.CalcSpatialAccelerationsFromVdot(context, vdot)
+        n = len(self._bodies)
+        D = np.zeros((n, 6))
+        for i, body in enumerate(self._bodies):
+            X = plant.EvalBodyPoseInWorld(context, body)
+            V = plant.EvalBodySpatialVelocityInWorld(context, body)
+            A = accelerations[int(body.index())]
+            R = X.rotation().matrix()
+            r = R @ self._com_B[i]
+            c = X.translation() + r
+            w, alpha = V.rotational(), A.rotational()
+            a_c = A.translational() + cross(alpha, r) + cross(w, cross(w, r))
+            inertia = R @ self._inertia_B[i] @ R.T
+            f = self._mass[i] * (a_c - self._g)
+            D[i, :3] = cross(c, f) + inertia @ alpha + cross(w, inertia @ w)
+            D[i, 3:] = f
+        measured = self._sensors_in_world(context, sensors)
+        out = np.zeros((len(self.pieces), 6))
+        for k, piece in enumerate(self.pieces):
+            out[k] = D[list(piece.bodies)].sum(axis=0)
+            for m, sign in piece.sensors:
+                out[k] -= sign * measured[m]
+        return out
+
+    def _sensors_in_world(self, context: Context, sensors: np.ndarray) -> np.ndarray:
+        """The sensors' wrenches (on their child sides) about the world origin, in W."""
+        out = np.zeros((len(self._joints), 6))
+        for m, joint in enumerate(self._joints):
+            X = joint.frame_on_child().CalcPoseInWorld(context)
+            R = X.rotation().matrix()
+            tau, f = R @ sensors[6 * m : 6 * m + 3], R @ sensors[6 * m + 3 : 6 * m + 6]
+            out[m, :3] = tau + cross(X.translation(), f)
+            out[m, 3:] = f
+        return out
+
+
+def _parent(plant: MultibodyPlant, body):
+    """body's parent body in the tree, None at the root (the floating base)."""
+    for j in plant.GetJointIndices(body.model_instance()):
+        joint = plant.get_joint(j)
+        if joint.child_body().index() == body.index():
+            return joint.parent_body()
+    return None
+
+
+def wrench_at(wrench_O: np.ndarray, point_W: np.ndarray) -> np.ndarray:
+    """A wrench [torque; force] about the world origin, shifted to point_W."""
+    return np.r_[wrench_O[:3] - cross(point_W, wrench_O[3:]), wrench_O[3:]]

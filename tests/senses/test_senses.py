@@ -1,0 +1,161 @@
+"""The robot's own senses and muscles (robot.hardware: icub, drake_standup/senses): the
+wiring keeps the simulator's truth from the controller, the pieces' balance against the
+whole robot's, the sensors' resolution and noise, and the closed loop under icub."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from pydrake.systems.framework import Diagram
+
+from drake_standup.config import ScenarioError, load_scenario
+from drake_standup.senses.estimator import exp_rotation, rotation_vector
+from drake_standup.senses.hardware import FT_JOINTS, NOMINAL
+from drake_standup.senses.sensors import quantize, quantize_rate, tick_noise
+from drake_standup.senses.subtrees import RobotPieces
+from drake_standup.sim.diagram import build_diagram
+from drake_standup.world.scene import set_seated_state
+
+# What may feed the controller under icub: the senses' systems (and the human's switch
+# and the response, which are not measurements of the robot).
+SENSES = {"estimator", "estimated_sensing", "estimated_seat_pad_normal_forces_N"}
+SENSES |= {"estimated_pads_vertical_force_N", "response"}
+
+
+@pytest.fixture(scope="module")
+def built():
+    return build_diagram(load_scenario(overrides=[("robot.hardware", "icub")]))
+
+
+def _leaf_source(root, box, index):
+    """The leaf system and output that feed box's input index (through exported ports)."""
+    source, output = root.connection_map()[(box, index)]
+    while isinstance(source, Diagram):
+        source, output = source.get_output_port_locator(output)
+    return source, output
+
+
+def test_no_truth_reaches_the_controller_under_icub(built):
+    """Every input of the stand-up controller (state machine, advancement, CoM reference,
+    whole-body controller) comes from the senses, and the estimator's only from the
+    sensors: no port of the plant's state or contact results reaches them."""
+    root = built.diagram
+    systems = {s.get_name(): s for s in root.GetSystems()}
+    brain = systems["standup_controller"]
+    for i in range(brain.num_input_ports()):
+        port = brain.get_input_port(i)
+        if port.get_name() == "stand_up":
+            continue
+        source, _ = _leaf_source(root, brain, port.get_index())
+        assert source.get_name() in SENSES, (port.get_name(), source.get_name())
+    estimator = systems["estimator"]
+    for i in range(estimator.num_input_ports()):
+        source, _ = _leaf_source(root, estimator, estimator.get_input_port(i).get_index())
+        assert source.get_name() == "robot_sensors"
+    sensing = systems["estimated_sensing"]
+    for i in range(sensing.num_input_ports()):
+        source, _ = _leaf_source(root, sensing, sensing.get_input_port(i).get_index())
+        assert source.get_name() == "estimator"
+    # The plant's actuation comes through the muscles, not from the controller directly.
+    station = systems["station"]
+    index = station.GetInputPort("actuation").get_index()
+    assert _leaf_source(root, station, index)[0].get_name() == "muscles"
+
+
+def test_an_unknown_hardware_is_one_line_naming_the_accepted():
+    with pytest.raises(
+        ScenarioError, match=r"robot.hardware: 'real' unknown; accepted: ideal \| icub"
+    ):
+        load_scenario(overrides=[("robot.hardware", "real")])
+
+
+def test_icub_sets_the_robots_rate_and_step():
+    scenario = load_scenario(overrides=[("robot.hardware", "icub")])
+    assert scenario.controller_period_s == pytest.approx(0.01)
+    assert scenario.plant.time_step == scenario.hardware.plant_time_step_s
+
+
+def test_the_pieces_carry_the_robots_weight_whatever_the_sensors_read(built):
+    """At rest the pieces' external wrenches sum to what holds the whole robot up, -m g
+    at its CoM, whatever the sensors read (each sensor's wrench enters the pieces on
+    its two sides with opposite signs); Drake's mass and CoM are the reference."""
+    own = built.station.scene
+    plant, instance = own.plant, own.robot.model_instance
+    context = plant.CreateDefaultContext()
+    set_seated_state(own, context)
+    pieces = RobotPieces(plant, instance, list(FT_JOINTS))
+    assert len(pieces.pieces) == 7
+    assert sorted(len(p.sensors) for p in pieces.pieces) == [1, 1, 1, 1, 2, 2, 4]
+    vdot = np.zeros(plant.num_velocities(instance))
+    rng = np.random.default_rng(3)
+    total = pieces.external_wrenches(context, vdot, rng.normal(0, 50, 36)).sum(axis=0)
+    m = plant.CalcTotalMass(context, [instance])
+    c = plant.CalcCenterOfMassPositionInWorld(context, [instance])
+    g = plant.gravity_field().gravity_vector()
+    np.testing.assert_allclose(total[3:], -m * g, atol=1e-9)
+    np.testing.assert_allclose(total[:3], -np.cross(c, m * g), atol=1e-9)
+
+
+def test_the_sensors_resolution_and_noise():
+    q = np.array([0.0, 1e-4, 1.0, -2.5])
+    step = 2 * np.pi / NOMINAL.encoder_counts
+    assert np.all(np.abs(quantize(q, NOMINAL.encoder_counts) - q) <= step / 2 + 1e-15)
+    assert quantize(q, NOMINAL.encoder_counts)[1] == 0.0  # below half a count
+    rate = 2 * np.pi / (14400 * 100) / 0.001
+    assert quantize_rate(np.array([0.3 * rate, 1.7 * rate]), NOMINAL).tolist() == [0.0, 2 * rate]
+    draws = np.array([tick_noise(NOMINAL, k)["ft"][3] for k in range(4000)])
+    assert np.std(draws) == pytest.approx(NOMINAL.ft_force_noise_N, rel=0.05)
+    assert np.array_equal(tick_noise(NOMINAL, 7)["imu"], tick_noise(NOMINAL, 7)["imu"])
+
+
+def test_rotation_log_and_exp_are_inverse():
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        w = rng.normal(0, 1, 3)
+        w *= min(1.0, 3.0 / np.linalg.norm(w))
+        np.testing.assert_allclose(rotation_vector(exp_rotation(w)), w, atol=1e-9)
+
+
+@pytest.mark.slow
+def test_icub_assisted_stands_up_sooner_and_knows_itself(tmp_path):
+    """Issue 49: under icub the default scenario stands up, at least 20% sooner than
+    alone, with its estimates' errors stated and bounded."""
+    from drake_standup.cli import main
+
+    assert (
+        main(["run", "--set", "robot.hardware=icub", "--no-recording", "--out", str(tmp_path)]) == 0
+    )
+    metrics = json.loads((tmp_path / "metrics.json").read_text())
+    assert metrics["success"]
+    assert metrics["standup_time_s"] <= 0.8 * metrics["standup_time_s_without_advancement"]
+    est = metrics["estimation"]
+    assert est["base_position_rms_m"] < 0.01
+    assert est["com_velocity_rms_mps"] < 0.05
+    assert est["hand_force_rms_N"] < 10.0
+
+
+@pytest.mark.slow
+def test_icub_psi_is_time_when_nobody_pulls(tmp_path):
+    """The noise must not advance psi: the hands' contact detector reads it as no pull."""
+    from drake_standup.cli import main
+
+    out = tmp_path / "run"
+    assert (
+        main(
+            [
+                "run",
+                "--scenario",
+                "unassisted",
+                "--set",
+                "robot.hardware=icub",
+                "--no-recording",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
+    signals = np.load(out / "signals.npz")
+    assert np.array_equal(signals["psi"], signals["time_s"])
