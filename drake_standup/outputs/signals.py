@@ -149,6 +149,9 @@ def _estimation_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.nd
             n, len(station.pad_groups), 3
         ),
         "imu_attitude_wxyz": logs["imu_attitude_W"],
+        # The advancement's law on the estimates, and on the truth at the same instant.
+        "psi_dot_law": logs["psi_dot_law"][:, 0],
+        "psi_dot_law_from_truth": logs["psi_dot_law_from_truth"][:, 0],
     }
 
 

@@ -19,7 +19,9 @@ Once a tick, from the encoders, the waist IMU and the six F/T sensors (sensors.p
                 advancement reads the estimate's error with nobody pulling as no pull
 
 Outputs (state outputs: what one tick computed is what the controller reads at the next):
-robot_state (the estimate, [q; v] as the plant's), hand_wrenches_W (12,
+robot_state (the estimate, [q; v] as the plant's, its positions moved on by the velocities
+to when the torques computed from it act (_predicted): at 100 Hz the tick's latency made
+the soles chatter, 138 N against 35 N at 250 Hz, measured), hand_wrenches_W (12,
 payloads.HAND_WRENCHES), pad_forces_W (3 a pad, the station's pad order), imu_attitude_W (4,
 the attitude filter's quaternion of the base, for the figures).
 The estimator starts from the robot's known seated pose (its world frame set at its feet).
@@ -153,12 +155,22 @@ class RobotEstimator(LeafSystem):
         anchor[0] = 1.0
         self._switch_anchor(anchor, wrenches)
         out.set_value(self._touch, touch)
-        out.set_value(self._x, x)
+        out.set_value(self._x, self._predicted(R_WB, p_WB, q_j, v))
         out.set_value(self._anchor, anchor)
         out.set_value(self._vdot, vdot)
         out.set_value(self._attitude, RotationMatrix(R_WS).ToQuaternion().wxyz())
         out.set_value(self._hands_state, hands)
         out.set_value(self._pads_state, pads)
+
+    def _predicted(self, R_WB, p_WB, q_j, v) -> np.ndarray:
+        """The state in the middle of the tick over which the torques computed from it act,
+        delay_ticks + 1/2 ticks on (the measurements' latency compensated): the positions
+        moved on by the velocities (sole chatter 138 N without, 53 N to the tick's start,
+        32 N to its middle; measured on the default run)."""
+        h = (self._hw.delay_ticks + 0.5) * self._hw.period_s
+        R = exp_rotation(v[:3] * h) @ R_WB
+        quat = RotationMatrix(R).ToQuaternion().wxyz()
+        return np.r_[quat, p_WB + v[3:6] * h, q_j + v[6:] * h, v]
 
     def _hand_contacts(self, touch: np.ndarray, hands: np.ndarray) -> np.ndarray:
         """Each hand's contact, a Schmitt trigger on its estimated force (as robotology's

@@ -24,6 +24,7 @@ from drake_standup.helper.work import HelperWork
 from drake_standup.robot.icub import actuated_joints
 from drake_standup.senses.wiring import add_muscles, add_senses
 from drake_standup.sim.visuals import StandupVisuals
+from drake_standup.standup.advancement import TrajectoryAdvancement, for_robot
 from drake_standup.standup.plan import StandupPlan, feet_reach, make_plan
 from drake_standup.standup.standup_controller import StandupController, make_standup_controller
 from drake_standup.world.scene import Scene, set_seated_state
@@ -226,7 +227,31 @@ def _add_standup_controller(
             estimated_state=senses.controller_inputs["robot_state"],
         )
     outputs |= {name: brain.GetOutputPort(name) for name in CONTROLLER_SIGNALS}
+    if senses is not None:
+        outputs |= _add_law_from_truth(builder, scenario, station, world, brain, outputs)
     return standup
+
+
+def _add_law_from_truth(
+    builder, scenario: Scenario, station: Station, world, brain, outputs: dict
+) -> dict:
+    """Under robot.hardware: icub, the advancement's law as the truth would have it: the
+    same law on the true CoM, its velocity and the true pull, along the same reference,
+    beside the law the robot's estimates drive (psi_dot_law)."""
+    plant, robot = station.plant, station.robot
+    mass = plant.CalcTotalMass(plant.CreateDefaultContext(), [robot.model_instance])
+    law = builder.AddNamedSystem(
+        "advancement_from_truth", TrajectoryAdvancement(for_robot(scenario.advancement, mass))
+    )
+    for name in ("com_W", "com_velocity_W", "omega_f_W"):
+        builder.Connect(world.GetOutputPort(name), law.GetInputPort(name))
+    for name in ("x_d_W", "path_tangent_W", "path_progress", "advances"):
+        builder.Connect(brain.GetOutputPort(name), law.GetInputPort(name))
+    builder.Connect(outputs["response"], law.GetInputPort("response"))
+    return {
+        "psi_dot_law": brain.GetOutputPort("psi_dot_law"),
+        "psi_dot_law_from_truth": law.GetOutputPort("psi_dot_law"),
+    }
 
 
 def _export_and_log(

@@ -8,6 +8,7 @@ from pathlib import Path
 from pydrake.common.yaml import yaml_dump_typed
 
 from drake_standup.outputs import figures
+from drake_standup.outputs.estimation import figure_estimation
 from drake_standup.outputs.json_files import write_metrics
 from drake_standup.outputs.recording import export_diagram, write_recording
 from drake_standup.outputs.signals import write_signals
@@ -40,6 +41,9 @@ def write_run(
     figures.figure_advancement(result.signals, baseline, entries, files["figure_advancement"])
     files["figure_tracking"] = out_dir / "figure_tracking.png"
     figures.figure_tracking(result.signals, entries, files["figure_tracking"])
+    if "estimated_com_W" in result.signals:  # robot.hardware: icub
+        files["figure_estimation"] = out_dir / "figure_estimation.png"
+        figure_estimation(result.signals, entries, files["figure_estimation"])
     files["metrics"] = out_dir / "metrics.json"
     write_metrics(files["metrics"], result.metrics)
     return files

@@ -103,6 +103,11 @@ _OUTPUTS = {
     "lean_W": ("controller", "lean_W"),
     "compliance_W": ("controller", "compliance_W"),
     "mass_estimate": ("controller", "mass_estimate"),
+    # What an advancement law beside this one reads (sim/diagram.py: the law from the truth).
+    "path_tangent_W": ("com_reference", "path_tangent_W"),
+    "path_progress": ("com_reference", "path_progress"),
+    "advances": ("state_machine", "advances"),
+    "psi_dot_law": ("advancement", "psi_dot_law"),
 }
 
 
