@@ -15,8 +15,9 @@ Once a tick, from the encoders, the waist IMU and the six F/T sensors (sensors.p
     wrenches    each piece's external wrench (subtrees.py) from the F/T sensors less the
                 piece's own dynamics at the estimated state and the base's filtered acceleration:
                 the hands' wrenches and each pad's force (wholeBodyDynamics' idea); a
-                hand's wrench is zero until its contact is made (_hand_contacts), so the
-                advancement reads the estimate's error with nobody pulling as no pull
+                hand's wrench is zero until its contact is made and then fades in
+                (_hand_contacts), so the advancement reads the estimate's error with
+                nobody pulling as no pull
 
 Outputs (state outputs: what one tick computed is what the controller reads at the next):
 robot_state (the estimate, [q; v] as the plant's, its positions moved on by the velocities
@@ -109,7 +110,7 @@ class RobotEstimator(LeafSystem):
         R_WS = self._imu_frame.CalcPoseInWorld(self._context).rotation()
         self._attitude = self.DeclareDiscreteState(R_WS.ToQuaternion().wxyz())
         self._hands_state = self._declare(12)
-        self._touch = self._declare(4)
+        self._touch = self._declare(6)
         self._pads_state = self._declare(3 * n_pads)
         self._encoders = self.DeclareVectorInputPort("encoder_positions", self._nj)
         self._velocities = self.DeclareVectorInputPort("encoder_velocities", self._nj)
@@ -151,7 +152,7 @@ class RobotEstimator(LeafSystem):
             ]
         )
         touch = self._hand_contacts(get(self._touch).value(), hands)
-        hands = hands * np.repeat(touch[:2], 6)
+        hands = hands * np.repeat(touch[4:6], 6)
         anchor[0] = 1.0
         self._switch_anchor(anchor, wrenches)
         out.set_value(self._touch, touch)
@@ -176,7 +177,10 @@ class RobotEstimator(LeafSystem):
         """Each hand's contact, a Schmitt trigger on its estimated force (as robotology's
         estimators detect the feet's): made once the force stays above
         hand_contact_make_N for hand_contact_time_s, broken once it stays below
-        hand_contact_break_N as long; touch: [contact (2), time past the threshold (2)]."""
+        hand_contact_break_N as long; the wrench's weight then ramps to 1 (or 0) over
+        hand_contact_time_s, so that no make or break steps the controller's input
+        (a step of the make threshold, 5 N a hand, otherwise). touch: [contact (2), time
+        past the threshold (2), weight (2)]."""
         hw, T = self._hw, self._hw.period_s
         touch = touch.copy()
         for i in range(2):
@@ -187,6 +191,10 @@ class RobotEstimator(LeafSystem):
             touch[2 + i] = touch[2 + i] + T if crossing else 0.0
             if touch[2 + i] >= hw.hand_contact_time_s - 1e-9:
                 touch[i], touch[2 + i] = 1.0 - touch[i], 0.0
+            step = T / hw.hand_contact_time_s
+            touch[4 + i] = (
+                min(1.0, touch[4 + i] + step) if touch[i] else max(0.0, touch[4 + i] - step)
+            )
         return touch
 
     def _attitude_step(self, wxyz: np.ndarray, imu: np.ndarray, T: float) -> np.ndarray:

@@ -104,15 +104,16 @@ def check_responses(names: list[str]) -> list[str]:
     return list(dict.fromkeys(names))
 
 
-def _runs(helpers: list[Helper], responses: list[str]) -> list[dict]:
-    """A run per helper and response: its record without metrics."""
+def _runs(helpers: list[Helper], responses: list[str], extra: tuple = ()) -> list[dict]:
+    """A run per helper and response: its record without metrics; extra: (key path,
+    value) overrides on every run (--set), after the helper's."""
     from drake_standup.config import parse_scenario
     from drake_standup.studies.sweep_file import run_key
 
     runs = []
     for helper in helpers:
         for response in responses:
-            overrides = [*helper.overrides, ("response", response)]
+            overrides = [*helper.overrides, *extra, ("response", response)]
             parse_scenario(helper.base_text, helper.name, overrides)  # checked before the cluster
             runs.append(
                 {
@@ -134,12 +135,13 @@ def run_compare(
     workers: int = 2,
     address: str | None = None,
     progress: bool = True,
+    extra: tuple = (),
 ) -> list[dict]:
     """Simulates what out_dir/runs/ does not hold yet; writes the table, Markdown and
     figure; returns the records (params, metrics) in helper-then-response order."""
     from drake_standup.studies.sweep import run_one, run_resumable
 
-    runs = _runs(helpers, responses)
+    runs = _runs(helpers, responses, extra)
     records, _ = run_resumable(
         runs,
         Path(out_dir) / "runs",
@@ -336,6 +338,14 @@ def main(
         help="the responses to compare (default: advancement stiff compliant)",
     )
     parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY.PATH=VALUE",
+        help="override one value of every helper's scenario, e.g. robot.hardware=icub",
+    )
+    parser.add_argument(
         "--workers", type=positive_int, default=2, help="LocalCluster worker processes (2)"
     )
     parser.add_argument(
@@ -347,18 +357,22 @@ def main(
     args = parser.parse_args(argv)
 
     from drake_standup.config import RESPONSES, ScenarioError, check_output_dir
+    from drake_standup.config.arguments import parse_set
 
     try:
         responses = check_responses(args.responses or list(RESPONSES))
         helpers = [resolve_helper(name) for name in dict.fromkeys(args.helpers)]
-        _runs(helpers, responses)
+        extra = tuple(parse_set(text) for text in args.overrides)
+        _runs(helpers, responses, extra)
         out = check_output_dir(args.out, "--out")
     except (CompareError, ScenarioError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     t0 = time.perf_counter()
     try:
-        records = run_compare(helpers, responses, out, workers=args.workers, address=args.address)
+        records = run_compare(
+            helpers, responses, out, workers=args.workers, address=args.address, extra=extra
+        )
     except OSError as err:
         print(f"error: --address {args.address}: {err}", file=sys.stderr)
         return 2

@@ -36,6 +36,17 @@ def test_a_campaign_helper_is_that_runs_overrides_and_each_response_is_one_more(
     assert len({r["run_id"] for r in runs}) == 3
 
 
+def test_set_overrides_every_helpers_runs_and_keys_them_apart():
+    """compare --set robot.hardware=icub: each run's scenario has it (and the rate it
+    sets), and the runs are other runs than without it (their ids differ)."""
+    helper = compare.resolve_helper("reactive")
+    plain = compare._runs([helper], ["advancement"])
+    runs = compare._runs([helper], ["advancement"], (("robot.hardware", "icub"),))
+    scenario = parse_scenario(runs[0]["base_text"], "x", runs[0]["overrides"])
+    assert scenario.robot.hardware == "icub" and scenario.controller_period_s == 0.01
+    assert runs[0]["run_id"] != plain[0]["run_id"]
+
+
 def _record(helper, response, t, work, success=True):
     metrics = {
         "success": success,
