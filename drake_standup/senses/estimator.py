@@ -13,7 +13,7 @@ Once a tick, from the encoders, the waist IMU and the six F/T sensors (sensors.p
                 filter's bias); the angular velocity the gyroscope's; the linear one the
                 sole's standing still
     wrenches    each piece's external wrench (subtrees.py) from the F/T sensors less the
-                piece's own dynamics at the estimated state and the base's filtered acceleration:
+                piece's own dynamics at the estimated state and accelerations over the tick:
                 the hands' wrenches and each pad's force (wholeBodyDynamics' idea); a
                 hand's wrench is zero until its contact is made and then fades in
                 (_hand_contacts), so the advancement reads the estimate's error with
@@ -66,11 +66,6 @@ def exp_rotation(w: np.ndarray) -> np.ndarray:
     return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * K @ K
 
 
-def first_order_gain(cutoff_hz: float, period_s: float) -> float:
-    """The discrete first-order filter's gain a (y += a (u - y)) for cutoff_hz at period_s."""
-    return 1.0 - math.exp(-2.0 * math.pi * cutoff_hz * period_s)
-
-
 class RobotEstimator(LeafSystem):
     """The module docstring's system, every hw.period_s."""
 
@@ -95,7 +90,6 @@ class RobotEstimator(LeafSystem):
             for f in pads
         ]
         self._hand_piece = [self._pieces.piece_of(f.body().name()) for f in self._hands]
-        self._a_a = first_order_gain(hw.acceleration_filter_hz, hw.period_s)
         self._tilt_weight = _tilt_weight(hw)
         x0 = np.asarray(x0, dtype=float)
         plant.SetPositionsAndVelocities(self._context, self._instance, x0)
@@ -105,7 +99,6 @@ class RobotEstimator(LeafSystem):
         # [started, anchor sole (0 left, 1 right), anchor's p (3) and quaternion (4)]
         anchor = np.r_[0.0, 0.0, X_WF.translation(), X_WF.rotation().ToQuaternion().wxyz()]
         self._anchor = self.DeclareDiscreteState(anchor)
-        self._vdot = self._declare(self._nv)
         # The attitude filter's R_WS, the IMU frame's (its first: the seated pose's).
         R_WS = self._imu_frame.CalcPoseInWorld(self._context).rotation()
         self._attitude = self.DeclareDiscreteState(R_WS.ToQuaternion().wxyz())
@@ -139,8 +132,10 @@ class RobotEstimator(LeafSystem):
         R_WB, p_WB, R_BS = self._base_pose(q_j, R_WS, anchor)
         w_W, v_Bo = self._base_velocity(R_WB, p_WB, q_j, R_BS @ imu[:3], v_j, int(anchor[1]))
         v = np.r_[w_W, v_Bo, v_j]
-        vdot_prev = get(self._vdot).value()
-        vdot = vdot_prev + self._a_a * ((v - v_prev) / T - vdot_prev) if started else vdot_prev
+        # The accelerations over the tick, unfiltered, as the F/T sensors are: a filter on
+        # one and not the other (3 Hz) made the arms' estimated wrench lag their motion, and
+        # the arms oscillated against the controller's compensation (measured).
+        vdot = (v - v_prev) / T if started else np.zeros(self._nv)
         x = np.r_[RotationMatrix(R_WB).ToQuaternion().wxyz(), p_WB, q_j, v]
         self._plant.SetPositionsAndVelocities(self._context, self._instance, x)
         wrenches = self._pieces.external_wrenches(self._context, vdot, self._ft.Eval(context))
@@ -158,7 +153,6 @@ class RobotEstimator(LeafSystem):
         out.set_value(self._touch, touch)
         out.set_value(self._x, self._predicted(R_WB, p_WB, q_j, v))
         out.set_value(self._anchor, anchor)
-        out.set_value(self._vdot, vdot)
         out.set_value(self._attitude, RotationMatrix(R_WS).ToQuaternion().wxyz())
         out.set_value(self._hands_state, hands)
         out.set_value(self._pads_state, pads)

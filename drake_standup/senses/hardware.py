@@ -50,8 +50,6 @@ class ICubHardware:
     motor_encoder_counts: int
     gear_ratio: float
     board_period_s: float
-    # The base acceleration's first-order filter (wholeBodyDynamics' filters), Hz.
-    acceleration_filter_hz: float
     # The waist IMU: white noise (std at the robot's rate) and a constant bias.
     gyro_noise_rad_s: float
     gyro_bias_rad_s: float
@@ -105,9 +103,6 @@ NOMINAL = ICubHardware(
     motor_encoder_counts=14400,
     gear_ratio=100.0,
     board_period_s=0.001,
-    # wholeBodyDynamics' joint-acceleration filter on iCubGenova04 (robots-configuration,
-    # estimators/wholebodydynamics.xml: jointAccFilterCutoffInHz 3.0).
-    acceleration_filter_hz=3.0,
     # Bosch BNO055 datasheet (BST-BNO055-DS000-14): gyroscope 0.014 deg/s/sqrt(Hz),
     # zero-rate offset +-1 deg/s; accelerometer 150 ug/sqrt(Hz), zero-g offset +-80 mg.
     gyro_noise_rad_s=0.014 * _DEG * math.sqrt(_BANDWIDTH_HZ),

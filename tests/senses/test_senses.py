@@ -132,10 +132,13 @@ def test_icub_assisted_stands_up_sooner_and_knows_itself(tmp_path):
     assert metrics["success"]
     assert metrics["standup_time_s"] <= 0.9 * metrics["standup_time_s_without_advancement"]
     assert metrics["sole_force_chatter_N"] <= 40.0
+    # Below the errors at which the sensitivity study (sweeps/hardware.yaml: 3 times the
+    # noise and bias, 3 ticks of delay) still stood up sooner every time: base 6.0 mm,
+    # CoM velocity 15 mm/s RMS (docs/results.md, "On its own senses and muscles").
     est = metrics["estimation"]
-    assert est["base_position_rms_m"] < 0.01
-    assert est["com_velocity_rms_mps"] < 0.05
-    assert est["hand_force_rms_N"] < 10.0
+    assert est["base_position_rms_m"] < 0.006
+    assert est["com_velocity_rms_mps"] < 0.015
+    assert est["hand_force_rms_N"] < 5.0
 
 
 @pytest.mark.slow
