@@ -164,3 +164,108 @@ def test_icub_psi_is_time_when_nobody_pulls(tmp_path):
     )
     signals = np.load(out / "signals.npz")
     assert np.array_equal(signals["psi"], signals["time_s"])
+
+
+def _muscles(built):
+    """A JointMuscles of the station's robot at a 5 ms step, every joint of inertia 0.05."""
+    from drake_standup.senses.hardware import hardware
+    from drake_standup.senses.muscles import JointMuscles
+
+    station = built.station
+    plant, instance = station.plant, station.robot.model_instance
+    nu = len(station.joints.names)
+    hw = hardware(load_scenario(overrides=[("robot.hardware", "icub")]).hardware)
+    q0 = plant.GetPositions(plant.CreateDefaultContext(), instance)
+    muscles = JointMuscles(
+        plant, instance, station.joints, hw, 0.005, inertia=np.full(nu, 0.05), q0=q0
+    )
+    return muscles, hw, plant, instance, station.joints
+
+
+def _step(muscles, context) -> None:
+    """One of the muscles' periodic updates (the plant's step), applied to context."""
+    context.SetDiscreteState(
+        muscles.EvalUniquePeriodicDiscreteUpdate(context).get_vector(0).value()
+    )
+
+
+def test_the_torque_loop_follows_a_step_as_its_first_order_lag(built):
+    """A step of the command: the torque after k plant steps is 1 - exp(-k h / tau) of it
+    (the exact discretisation of the boards' first-order loop), on a torque-mode joint at
+    rest (no friction, nothing to compensate)."""
+    muscles, hw, plant, instance, joints = _muscles(built)
+    context = muscles.CreateDefaultContext()
+    state = np.zeros(plant.num_multibody_states(instance))
+    state[: plant.num_positions(instance)] = plant.GetPositions(
+        plant.CreateDefaultContext(), instance
+    )
+    muscles.GetInputPort("robot_state").FixValue(context, state)
+    muscles.GetInputPort("estimated_state").FixValue(context, state)
+    nu = len(joints.names)
+    muscles.GetInputPort("command").FixValue(context, np.zeros(nu))
+    _step(muscles, context)  # started, at 0 N m
+    command = np.zeros(nu)
+    knee = joints.names.index("l_knee")
+    command[knee] = 10.0
+    muscles.GetInputPort("command").FixValue(context, command)
+    for k in range(1, 4):
+        _step(muscles, context)
+        expected = 10.0 * (1.0 - np.exp(-k * 0.005 / hw.torque_time_constant_s))
+        assert muscles.GetOutputPort("actuation").Eval(context)[knee] == pytest.approx(expected)
+
+
+def test_friction_opposes_the_joints_velocity_by_the_identified_law(built):
+    """The plant's friction is -scale (Fc tanh(v / v_s) + Fv v) on each joint's velocity
+    index, nothing elsewhere."""
+    muscles, hw, plant, instance, joints = _muscles(built)
+    context = muscles.CreateDefaultContext()
+    nq = plant.num_positions(instance)
+    rng = np.random.default_rng(1)
+    state = np.zeros(plant.num_multibody_states(instance))
+    rows = nq + np.asarray(joints.v_index)
+    state[rows] = rng.normal(0.0, 1.0, len(joints.names))
+    muscles.GetInputPort("robot_state").FixValue(context, state)
+    tau = muscles.GetOutputPort("generalized_friction").Eval(context)
+    v = state[rows]
+    fv = np.array([hw.friction_of(n).viscous_Nms for n in joints.names])
+    fc = np.array([hw.friction_of(n).coulomb_Nm for n in joints.names])
+    expected = -hw.friction_scale * (fc * np.tanh(v / muscles._vs) + fv * v)
+    columns = plant.num_velocities() - plant.num_velocities(instance) + np.asarray(joints.v_index)
+    np.testing.assert_allclose(tau[columns], expected, rtol=1e-12)
+    assert not np.any(np.delete(tau, columns))
+
+
+def test_the_estimate_at_rest_is_the_truth_within_the_sensors_resolution():
+    """Seated and still (nobody pulls), noise and bias off: after 0.5 s the estimated
+    joints are the true ones within half an encoder count (and the prediction's move at
+    their estimated speed), the base within 3 mm, the hands' wrenches zero and each pad's
+    load within 10 N of the truth."""
+    from drake_standup.sim.runner import advance, prepare
+
+    scenario = load_scenario(
+        "seated",
+        overrides=[
+            ("robot.hardware", "icub"),
+            ("hardware.ft_noise_scale", 0.0),
+            ("hardware.imu_bias_scale", 0.0),
+        ],
+    )
+    run = prepare(scenario)
+    assert advance(run, 0.5)
+    built, root = run.built, run.simulator.get_context()
+    station = built.station
+    nq = station.plant.num_positions(station.robot.model_instance)
+    truth = built.output("robot_state", root)
+    estimate = built.output("estimated_robot_state", root)
+    q, v = np.asarray(station.joints.q_index), nq + np.asarray(station.joints.v_index)
+    step = 2 * np.pi / NOMINAL.encoder_counts
+    moved = 1.5 * scenario.controller_period_s * np.abs(estimate[v])
+    # Half a count, the prediction's move, and the joints' own motion over the 10 ms hold.
+    assert np.all(
+        np.abs(estimate[q] - truth[q]) <= step / 2 + moved + 0.01 * np.abs(truth[v]) + 1e-9
+    )
+    assert np.linalg.norm(estimate[4:7] - truth[4:7]) < 0.003
+    assert not np.any(built.output("estimated_hand_wrenches_W", root))
+    pads = built.output("estimated_pad_forces_W", root).reshape(-1, 3)
+    true_pads = built.output("pad_forces_W", root).reshape(-1, 3)
+    assert np.max(np.abs(pads[:, 2] - true_pads[:, 2])) < 10.0
