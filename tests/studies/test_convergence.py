@@ -386,3 +386,21 @@ def test_a_bound_the_reference_itself_misses_is_judged_against_the_finer_run():
     # A count bound (extra crossings) is never relaxed.
     chatter = with_fine_reference(_verdict(1.0, crossings=2), _verdict(1.0), _verdict(15.0))
     assert chatter["failed"] == ["contact_crossings"]
+
+
+def test_every_task_binds_to_its_function(tmp_path):
+    """What the cluster calls, fn(*args), is a valid call of run_case for every case: a
+    task whose arguments did not bind failed every run of the study at once (the study
+    ran 0 of 24 cases, TypeError, before issue 49)."""
+    import inspect
+
+    from drake_standup.studies.convergence.cases import Case, case_inputs
+    from drake_standup.studies.convergence.study import _tasks
+
+    cases = [Case("assisted", 4.0), Case("seated", 5.0, 2)]
+    texts = {c.scenario: "duration_s: 1.0\n" for c in cases}
+    inputs = {c: case_inputs(c, texts[c.scenario], 1.0, ()) for c in cases}
+    tasks = _tasks(cases, texts, {"assisted": 1.0, "seated": 1.0}, inputs, tmp_path, [])
+    assert len(tasks) == 2
+    for _case, _key, fn, args in tasks:
+        inspect.signature(fn).bind(*args)

@@ -3,6 +3,7 @@ the step and writes convergence.json, convergence.md and convergence.png."""
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass
@@ -132,7 +133,9 @@ def _tasks(
         (
             c,
             f"convergence-{c.name}-{inputs[c]['hash']}",
-            run_case,
+            # run_case takes inputs and overrides by keyword (the tasks' arguments go
+            # positionally: passing them so failed every run with a TypeError).
+            functools.partial(run_case, inputs=inputs[c], overrides=list(overrides)),
             (
                 texts[c.scenario],
                 f"scenarios/{c.scenario}.yaml",
@@ -140,8 +143,6 @@ def _tasks(
                 c.controller_period_s,
                 durations[c.scenario],
                 str((runs_dir / c.name).resolve()),
-                inputs[c],
-                list(overrides),
             ),
         )
         for c in todo
