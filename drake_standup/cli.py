@@ -14,7 +14,7 @@ import importlib
 import sys
 from pathlib import Path
 
-from drake_standup.config.arguments import OneLineErrorParser, parse_set
+from drake_standup.config.arguments import OneLineErrorParser, add_set_argument, parse_set
 
 # Command -> (module with main(argv, prog), one line of help).
 COMMANDS = {
@@ -85,13 +85,9 @@ def run_parser(prog: str) -> OneLineErrorParser:
         help="a scenario YAML file, or a shipped scenario's name, e.g. unassisted "
         "(default: assisted; `drake-standup scenarios` lists them)",
     )
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY.PATH=VALUE",
-        help="override one scenario value (YAML), e.g. advancement.psi_dot_upper=2.0 or "
+    add_set_argument(
+        parser,
+        "override one scenario value (YAML), e.g. advancement.psi_dot_upper=2.0 or "
         "human.pulls[0].force_N=[20, 0, 20]; repeatable",
     )
     parser.add_argument(

@@ -37,6 +37,18 @@ def parse_set(text: str) -> tuple[str, object]:
     )
 
 
+def add_set_argument(parser, help_text: str) -> None:
+    """The repeatable --set KEY.PATH=VALUE option (into args.overrides, parse_set each)."""
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY.PATH=VALUE",
+        help=help_text,
+    )
+
+
 def positive_int(text: str) -> int:
     """An argparse type: a count >= 1."""
     value = int(text)

@@ -24,7 +24,12 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from drake_standup.config.arguments import OneLineErrorParser, positive_int
+from drake_standup.config.arguments import (
+    OneLineErrorParser,
+    add_set_argument,
+    parse_set,
+    positive_int,
+)
 from drake_standup.studies.sweep_table import finite_number
 
 # The scripted pull, the reactive partner, the person's body (issue 32), the lateral and
@@ -337,13 +342,8 @@ def main(
         metavar="R",
         help="the responses to compare (default: advancement stiff compliant)",
     )
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY.PATH=VALUE",
-        help="override one value of every helper's scenario, e.g. robot.hardware=icub",
+    add_set_argument(
+        parser, "override one value of every helper's scenario, e.g. robot.hardware=icub"
     )
     parser.add_argument(
         "--workers", type=positive_int, default=2, help="LocalCluster worker processes (2)"
@@ -357,7 +357,6 @@ def main(
     args = parser.parse_args(argv)
 
     from drake_standup.config import RESPONSES, ScenarioError, check_output_dir
-    from drake_standup.config.arguments import parse_set
 
     try:
         responses = check_responses(args.responses or list(RESPONSES))
