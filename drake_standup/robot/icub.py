@@ -325,11 +325,17 @@ class ActuatedJoints:
     v_index: np.ndarray  # (n_u,) into the instance's v
 
 
+def velocity_start(plant: MultibodyPlant, instance: ModelInstanceIndex) -> int:
+    """Where the instance's velocities start in the plant's v."""
+    joints = [plant.get_joint(j) for j in plant.GetJointIndices(instance)]
+    return min(j.velocity_start() for j in joints if j.num_velocities() > 0)
+
+
 def actuated_joints(plant: MultibodyPlant, instance: ModelInstanceIndex) -> ActuatedJoints:
     """The instance's actuated joints (add_icub: one actuator per revolute joint)."""
     joints = [plant.get_joint(j) for j in plant.GetJointIndices(instance)]
     first_q = min(j.position_start() for j in joints if j.num_positions() > 0)
-    first_v = min(j.velocity_start() for j in joints if j.num_velocities() > 0)
+    first_v = velocity_start(plant, instance)
     actuators = sorted(
         (plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(instance)),
         key=lambda a: a.input_start(),

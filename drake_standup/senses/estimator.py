@@ -38,6 +38,7 @@ from pydrake.math import RotationMatrix
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import Context, DiscreteValues, LeafSystem
 
+from drake_standup.robot.icub import velocity_start
 from drake_standup.robot.spatial import cross
 from drake_standup.senses.hardware import FT_JOINTS, IMU_FRAME, ICubHardware
 from drake_standup.senses.subtrees import RobotPieces, wrench_at
@@ -82,9 +83,8 @@ class RobotEstimator(LeafSystem):
         self._pieces = RobotPieces(plant, self._instance, list(FT_JOINTS))
         self._hands = [robot.frame(plant, h) for h in _HANDS]
         self._soles = [robot.frame(plant, s) for s in _SOLES]
-        self._root = plant.GetBodyByName("root_link", self._instance)
         self._imu_frame = plant.GetFrameByName(IMU_FRAME, self._instance)
-        self._v_start = _robot_v_start(plant, self._instance)
+        self._v_start = velocity_start(plant, self._instance)
         self._pad_piece = [
             self._pieces.piece_of(plant.GetFrameByName(f, self._instance).body().name())
             for f in pads
@@ -252,15 +252,6 @@ class RobotEstimator(LeafSystem):
             anchor[1] = other
             anchor[2:5] = X.translation()
             anchor[5:9] = X.rotation().ToQuaternion().wxyz()
-
-
-def _robot_v_start(plant, instance) -> int:
-    """Where the instance's velocities start in the plant's v."""
-    return min(
-        plant.get_joint(j).velocity_start()
-        for j in plant.GetJointIndices(instance)
-        if plant.get_joint(j).num_velocities() > 0
-    )
 
 
 def _tilt_weight(hw: ICubHardware) -> float:

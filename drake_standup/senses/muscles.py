@@ -29,6 +29,7 @@ import math
 import numpy as np
 from pydrake.systems.framework import BasicVector, Context, DiscreteValues, LeafSystem
 
+from drake_standup.robot.icub import velocity_start
 from drake_standup.senses.hardware import ICubHardware
 
 
@@ -66,11 +67,7 @@ class JointMuscles(LeafSystem):
             ]
         )
         self._gain = 1.0 - math.exp(-step_s / hw.torque_time_constant_s)
-        nv0 = min(
-            plant.get_joint(j).velocity_start()
-            for j in plant.GetJointIndices(instance)
-            if plant.get_joint(j).num_velocities() > 0
-        )
+        nv0 = velocity_start(plant, instance)
         nq = plant.num_positions(instance)
         self._v_state = nq + np.asarray(joints.v_index)  # in the instance's [q; v]
         self._v_plant = nv0 + np.asarray(joints.v_index)  # in the plant's v

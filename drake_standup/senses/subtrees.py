@@ -45,12 +45,16 @@ class RobotPieces:
         joints = [plant.GetJointByName(name, instance) for name in ft_joints]
         cut = {j.child_body().index(): k for k, j in enumerate(joints)}
         # Each body's piece: the nearest sensor above it (its child side), or the base.
+        parent = {
+            plant.get_joint(j).child_body().index(): plant.get_joint(j).parent_body().index()
+            for j in plant.GetJointIndices(instance)
+        }
         owner = []
         for body in self._bodies:
-            b = body
-            while b.index() not in cut and _parent(plant, b) is not None:
-                b = _parent(plant, b)
-            owner.append(cut.get(b.index(), -1))
+            b = body.index()
+            while b not in cut and b in parent:
+                b = parent[b]
+            owner.append(cut.get(b, -1))
         pieces = []
         for k in [-1, *range(len(joints))]:
             bodies = tuple(i for i, o in enumerate(owner) if o == k)
@@ -123,15 +127,6 @@ class RobotPieces:
             out[m, :3] = tau + cross(X.translation(), f)
             out[m, 3:] = f
         return out
-
-
-def _parent(plant: MultibodyPlant, body):
-    """body's parent body in the tree, None at the root (the floating base)."""
-    for j in plant.GetJointIndices(body.model_instance()):
-        joint = plant.get_joint(j)
-        if joint.child_body().index() == body.index():
-            return joint.parent_body()
-    return None
 
 
 def wrench_at(wrench_O: np.ndarray, point_W: np.ndarray) -> np.ndarray:

@@ -20,6 +20,7 @@ from pydrake.systems.primitives import DiscreteTimeDelay, MatrixGain
 from pydrake.systems.sensors import Accelerometer, Gyroscope
 
 from drake_standup.config import Scenario
+from drake_standup.robot.icub import velocity_start
 from drake_standup.senses.estimator import RobotEstimator
 from drake_standup.senses.hardware import IMU_FRAME, ICubHardware, hardware
 from drake_standup.senses.muscles import JointMuscles
@@ -160,11 +161,7 @@ def add_muscles(
     context = plant.CreateDefaultContext()
     set_seated_state(station.scene, context)
     M = plant.CalcMassMatrix(context)
-    start = min(
-        plant.get_joint(j).velocity_start()
-        for j in plant.GetJointIndices(robot.model_instance)
-        if plant.get_joint(j).num_velocities() > 0
-    )
+    start = velocity_start(plant, robot.model_instance)
     # What a torque at each joint alone moves: 1 / (M^-1)_jj (below M_jj: the links it carries
     # move with it).
     inertia = 1.0 / np.diag(np.linalg.inv(M))[start + np.asarray(station.joints.v_index)]
