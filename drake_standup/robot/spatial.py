@@ -46,6 +46,15 @@ def rotation_vector(R: np.ndarray) -> np.ndarray:
     return np.array([scale * x, scale * y, scale * z])
 
 
+def exp_rotation(w: np.ndarray) -> np.ndarray:
+    """The rotation matrix of axis-angle vector w (Rodrigues)."""
+    angle = float(np.linalg.norm(w))
+    if angle < 1e-12:
+        return np.eye(3)
+    K = skew(w / angle)
+    return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * K @ K
+
+
 def yaw_pitch_rotation(yaw_rad: float, pitch_rad: float) -> np.ndarray:
     """R = Rz(yaw) Ry(pitch)."""
     cy, sy = math.cos(yaw_rad), math.sin(yaw_rad)

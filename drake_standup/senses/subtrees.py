@@ -67,6 +67,7 @@ class RobotPieces:
             pieces.append(Piece(name, bodies, tuple(sensors)))
         self.pieces = pieces
         self._owner_piece = [[-1, *range(len(joints))].index(o) for o in owner]
+        self._body_index = [int(b.index()) for b in self._bodies]
         self._mass = np.array([b.default_mass() for b in self._bodies])
         self._com_B = np.array([b.default_com() for b in self._bodies])
         self._inertia_B = np.array(
@@ -78,6 +79,13 @@ class RobotPieces:
                 for b in self._bodies
             ]
         )
+        # Which bodies each piece sums, and with which sign each sensor's wrench enters it.
+        self._membership = np.zeros((len(pieces), len(self._bodies)))
+        self._sensor_signs = np.zeros((len(pieces), len(joints)))
+        for k, piece in enumerate(pieces):
+            self._membership[k, list(piece.bodies)] = 1.0
+            for m, sign in piece.sensors:
+                self._sensor_signs[k, m] = sign
         self._joints = joints
         self._g = plant.gravity_field().gravity_vector()
 
@@ -91,31 +99,28 @@ class RobotPieces:
     ) -> np.ndarray:
         """(n_pieces, 6) each piece's external wrench [torque; force] about the world origin,
         in W, at the state in context (the estimate), the accelerations vdot and the sensors'
-        wrenches (36: [torque; force] on the child side at each joint's child frame, in it)."""
+        wrenches (36: [torque; force] on the child side at each joint's child frame, in it).
+        All bodies at once in numpy (a loop over the 39 bodies cost 1.1 ms a tick)."""
         plant = self._plant
+        poses = plant.get_body_poses_output_port().Eval(context)
+        velocities = plant.get_body_spatial_velocities_output_port().Eval(context)
         accelerations = plant.CalcSpatialAccelerationsFromVdot(context, vdot)
-        n = len(self._bodies)
-        D = np.zeros((n, 6))
-        for i, body in enumerate(self._bodies):
-            X = plant.EvalBodyPoseInWorld(context, body)
-            V = plant.EvalBodySpatialVelocityInWorld(context, body)
-            A = accelerations[int(body.index())]
-            R = X.rotation().matrix()
-            r = R @ self._com_B[i]
-            c = X.translation() + r
-            w, alpha = V.rotational(), A.rotational()
-            a_c = A.translational() + cross(alpha, r) + cross(w, cross(w, r))
-            inertia = R @ self._inertia_B[i] @ R.T
-            f = self._mass[i] * (a_c - self._g)
-            D[i, :3] = cross(c, f) + inertia @ alpha + cross(w, inertia @ w)
-            D[i, 3:] = f
-        measured = self._sensors_in_world(context, sensors)
-        out = np.zeros((len(self.pieces), 6))
-        for k, piece in enumerate(self.pieces):
-            out[k] = D[list(piece.bodies)].sum(axis=0)
-            for m, sign in piece.sensors:
-                out[k] -= sign * measured[m]
-        return out
+        X = np.array([poses[i].GetAsMatrix34() for i in self._body_index])
+        w = np.array([velocities[i].rotational() for i in self._body_index])
+        A = np.array([accelerations[i].get_coeffs() for i in self._body_index])
+        R, alpha = X[:, :, :3], A[:, :3]
+        r = np.einsum("nij,nj->ni", R, self._com_B)
+        c = X[:, :, 3] + r
+        a_c = A[:, 3:] + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+        inertia = np.einsum("nij,njk,nlk->nil", R, self._inertia_B, R)
+        f = self._mass[:, None] * (a_c - self._g)
+        tau = (
+            np.cross(c, f)
+            + np.einsum("nij,nj->ni", inertia, alpha)
+            + np.cross(w, np.einsum("nij,nj->ni", inertia, w))
+        )
+        D = np.hstack([tau, f])
+        return self._membership @ D - self._sensor_signs @ self._sensors_in_world(context, sensors)
 
     def _sensors_in_world(self, context: Context, sensors: np.ndarray) -> np.ndarray:
         """The sensors' wrenches (on their child sides) about the world origin, in W."""

@@ -143,13 +143,13 @@ def add_muscles(
     station: Station,
     scenario: Scenario,
     world: System,
-    *,
+    senses: Senses,
     command: OutputPort,
-    estimated_state: OutputPort,
 ) -> None:
     """The joints between the controller's torques (command) and the plant: the delay's
-    ticks past the first (which the estimator's tick already makes), then JointMuscles."""
-    hw = hardware(scenario.hardware)
+    ticks past the first (which the estimator's tick already makes), then JointMuscles,
+    which compensate friction at the senses' estimated velocities."""
+    hw = senses.hardware
     plant, robot = station.plant, station.robot
     nu = len(station.joints.names)
     if hw.delay_ticks > 1:
@@ -179,7 +179,9 @@ def add_muscles(
     )
     builder.Connect(command, muscles.GetInputPort("command"))
     builder.Connect(world.GetOutputPort("robot_state"), muscles.GetInputPort("robot_state"))
-    builder.Connect(estimated_state, muscles.GetInputPort("estimated_state"))
+    builder.Connect(
+        senses.controller_inputs["robot_state"], muscles.GetInputPort("estimated_state")
+    )
     builder.Connect(muscles.GetOutputPort("actuation"), world.GetInputPort("actuation"))
     builder.Connect(
         muscles.GetOutputPort("generalized_friction"), world.GetInputPort("generalized_friction")

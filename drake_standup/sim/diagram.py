@@ -218,14 +218,7 @@ def _add_standup_controller(
     if senses is None:
         builder.Connect(brain.GetOutputPort("actuation"), world.GetInputPort("actuation"))
     else:
-        add_muscles(
-            builder,
-            station,
-            scenario,
-            world,
-            command=brain.GetOutputPort("actuation"),
-            estimated_state=senses.controller_inputs["robot_state"],
-        )
+        add_muscles(builder, station, scenario, world, senses, brain.GetOutputPort("actuation"))
     outputs |= {name: brain.GetOutputPort(name) for name in CONTROLLER_SIGNALS}
     if senses is not None:
         outputs |= _add_law_from_truth(builder, scenario, station, world, brain, outputs)
