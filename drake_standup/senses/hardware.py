@@ -74,6 +74,17 @@ class ICubHardware:
     hand_contact_time_s: float = 0.1
     # The joints held by their boards' position loops, not torque-controlled (name keys).
     position_mode: tuple[str, ...] = ()
+    # When the estimator calibrates the IMU's biases, s: the robot seated still once it has
+    # settled on the chair, its pose known from the legs (as wholeBodyDynamics calibrates
+    # the F/T sensors' offsets at start-up).
+    imu_calibration_s: tuple[float, float] = (0.5, 1.0)
+
+    @property
+    def latency_s(self) -> float:
+        """From a tick's measurements to the middle of the tick its torques act over:
+        delay_ticks + 1/2 ticks (what the estimator predicts its state over, and the
+        CoM reference is taken ahead by)."""
+        return (self.delay_ticks + 0.5) * self.period_s
 
     def friction_of(self, joint: str) -> JointFriction:
         for key, value in self.friction.items():
