@@ -136,9 +136,11 @@ class ControllerModel:
         period_s: float,
         *,
         last_com=None,
+        unknown_damping: dict[str, float] | None = None,
     ):
         """last_com: where the model puts each state's CoM for the sensing
-        (world/scene.py robot_last_com)."""
+        (world/scene.py robot_last_com); unknown_damping: the plant's joint damping the
+        model leaves out (RobotKinematics)."""
         if [spec.frame for spec in specs] != list(CONTACTS):
             raise ValueError(f"contact specs must be {CONTACTS}")
         self.specs = specs
@@ -154,6 +156,7 @@ class ControllerModel:
             other_frames=[spec.frame for spec in specs if not spec.constrained] + list(HANDS),
             hold_points_m={spec.frame: spec.hold_point_m for spec in specs},
             last_com=last_com,
+            unknown_damping=unknown_damping,
         )
         g = -plant.gravity_field().gravity_vector()[2]
         filter_s = config.mass_estimation_filter_s

@@ -85,11 +85,16 @@ class RobotKinematics:
         held_frames: list[str],
         other_frames: list[str],
         hold_points_m: dict[str, tuple[float, float, float]] | None = None,
+        *,
         last_com: LastCoM | None = None,
+        unknown_damping: dict[str, float] | None = None,
     ):
         """held_frames get the Jacobian and bias acceleration Jdot v of their hold point
         too (hold_points_m: its position in the frame; default the origin); last_com
-        gets each state's CoM for the sensing (robot/last_com.py)."""
+        gets each state's CoM for the sensing (robot/last_com.py); unknown_damping: the
+        damping of the plant's joints (by name) that is not the model's (Scene.
+        added_damping: the joints' true friction under icub, which the boards
+        compensate as they identified it)."""
         self.last_com = last_com
         instance = robot.model_instance
         if plant.num_velocities() != plant.num_velocities(instance) or plant.num_positions() != (
@@ -133,6 +138,7 @@ class RobotKinematics:
             joint = plant.get_joint(index)
             start, count = joint.velocity_start(), joint.num_velocities()
             self._damping[start : start + count] = joint.default_damping_vector()
+            self._damping[start : start + count] -= (unknown_damping or {}).get(joint.name(), 0.0)
 
     def set_mass_scale(self, scale: float) -> None:
         """Every body's mass scaled by scale from its default (CoM and unit inertia kept,

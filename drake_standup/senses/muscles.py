@@ -13,9 +13,15 @@ Between the controller and the plant, at the plant's step:
     position mode the joints iCub's whole-body torque control leaves to their boards'
                   position loops (hw.position_mode: neck and wrists) hold their seated
                   angles; the controller's torque for them goes unused
-    friction      the joint's true friction, the identified times hw.friction_scale, at
-                  its true velocity, into the plant's applied generalized force (the
-                  physics, not a sensor)
+    friction      the joint's true friction, the identified times hw.friction_scale (the
+                  physics, not a sensor): its viscous part as the plant's joint damping
+                  (wiring.joint_damping, beyond the URDF's), which the plant integrates
+                  implicitly; its Coulomb part here, at the true velocity, into the
+                  plant's applied generalized force. Applied explicitly, the viscous
+                  part's 0.2 N m s/rad took 1.97 of the 2 an explicit step allows
+                  (b h / I) on iCubGenova04's wrist pronosupination (5e-4 kg m^2): with
+                  the position loop's 0.5 it spun at 20-140 rad/s and the robot fell
+                  (iCubGenova04 and iCubErzelli02, measured).
 
 Coulomb friction is tanh-smoothed over a velocity v_s per joint, the smallest the explicit
 step keeps stable: the friction's slope Fc / v_s times the step over the joint's own
@@ -97,9 +103,9 @@ class JointMuscles(LeafSystem):
         )
         self.DeclarePeriodicDiscreteUpdateEvent(step_s, 0.0, self._Update)
 
-    def friction(self, v: np.ndarray) -> np.ndarray:
-        """The identified friction (n_u) at joint velocities v: Coulomb, smoothed, and viscous."""
-        return self._fc * np.tanh(v / self._vs) + self._fv * v
+    def coulomb(self, v: np.ndarray) -> np.ndarray:
+        """The identified Coulomb friction (n_u) at joint velocities v, smoothed."""
+        return self._fc * np.tanh(v / self._vs)
 
     def _Update(self, context: Context, out: DiscreteValues) -> None:
         state = context.get_discrete_state(self._lag).value()
@@ -120,5 +126,5 @@ class JointMuscles(LeafSystem):
     def _CalcFriction(self, context: Context, output: BasicVector) -> None:
         v = self._true.Eval(context)[self._v_state]
         tau = np.zeros(self._nv)
-        tau[self._v_plant] = -self._scale * self.friction(v)
+        tau[self._v_plant] = -self._scale * self.coulomb(v)
         output.SetFromVector(tau)

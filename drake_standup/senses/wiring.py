@@ -11,6 +11,7 @@ torques and the plant.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,6 +58,15 @@ class Senses:
     hardware: ICubHardware
     controller_inputs: dict[str, OutputPort]
     estimates: dict[str, OutputPort]
+
+
+def joint_damping(scenario: Scenario) -> Callable[[str], float] | None:
+    """The joints' viscous friction (N m s/rad by joint name, the identified times
+    hardware.friction_scale) for the plant's joint damping under icub; None under ideal."""
+    if scenario.robot.hardware != "icub":
+        return None
+    hw = hardware(scenario.hardware)
+    return lambda name: hw.friction_of(name).viscous_Nms * hw.friction_scale
 
 
 def add_senses(

@@ -22,7 +22,7 @@ from drake_standup.helper.body_control import make_body_helper
 from drake_standup.helper.hands import HumanWrenchSource
 from drake_standup.helper.work import HelperWork
 from drake_standup.robot.icub import actuated_joints
-from drake_standup.senses.wiring import add_muscles, add_senses
+from drake_standup.senses.wiring import add_muscles, add_senses, joint_damping
 from drake_standup.sim.visuals import StandupVisuals
 from drake_standup.standup.advancement import TrajectoryAdvancement, for_robot
 from drake_standup.standup.plan import StandupPlan, feet_reach, make_plan
@@ -103,6 +103,7 @@ def build_diagram(
         scenario,
         feet_reach(scenario.controller),
         (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad) if seat_hold else None,
+        joint_damping(scenario),
     )
     plan = make_plan(scenario, station)
     builder = DiagramBuilder()

@@ -138,9 +138,9 @@ def make_standup_controller(
         station.arm_joints,
         braced_drop_m=station.braced_drop_m,
     )
-    model = ControllerModel(
-        plant, robot, specs, config, period_s, last_com=robot_last_com(station.scene)
-    )
+    # The joints' friction beyond the URDF's damping is the boards' to compensate (icub).
+    known = {"last_com": robot_last_com(station.scene), "unknown_damping": scene.added_damping}
+    model = ControllerModel(plant, robot, specs, config, period_s, **known)
     systems = {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()

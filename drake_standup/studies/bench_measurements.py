@@ -25,6 +25,7 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_standup.config import Scenario
+from drake_standup.senses.wiring import joint_damping
 from drake_standup.sim.diagram import add_seat_hold, build_diagram
 from drake_standup.sim.simulate import RunResult, simulate
 from drake_standup.world.scene import add_scene, set_seated_state, without_body
@@ -101,7 +102,9 @@ def time_plant_step(scenario: Scenario, steps: int) -> dict:
     hold = scenario.seat_hold
     # The bare plant is the robot's scene: a helper's body needs its controller wired.
     pd_gains = (hold.kp_Nm_per_rad, hold.kd_Nms_per_rad)
-    scene = add_scene(builder, without_body(scenario), pd_gains=pd_gains)
+    scene = add_scene(
+        builder, without_body(scenario), pd_gains=pd_gains, joint_damping=joint_damping(scenario)
+    )
     instance = scene.robot.model_instance
     add_seat_hold(
         builder,

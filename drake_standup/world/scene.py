@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,6 +57,9 @@ class Scene:
     standing: StandingGeometry | None = None
     # The controller's model's CoM of the last state, for the sensing (robot_last_com).
     last_com: LastCoM | None = None
+    # Viscous damping the joints carry beyond the URDF's, by joint name (add_scene's
+    # joint_damping: the robot's friction under icub); not the controller's to know.
+    added_damping: dict[str, float] = dataclasses.field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -135,8 +139,11 @@ def add_scene(
     *,
     pd_gains: tuple[float, float] | None = None,
     visuals: bool = True,
+    joint_damping: Callable[[str], float] | None = None,
 ) -> Scene:
-    """Adds plant and scene graph to builder; returns the finalized scene."""
+    """Adds plant and scene graph to builder; returns the finalized scene. joint_damping:
+    viscous damping (N m s/rad) to add to each actuated joint's own (by its name), which
+    the plant integrates implicitly (None: the URDF's alone)."""
     plant, scene_graph = AddMultibodyPlant(scenario.plant, builder)
     robot = add_icub(
         plant,
@@ -150,6 +157,15 @@ def add_scene(
             scenario.robot.reflected_inertia, scenario.robot.model
         ),
     )
+    added = {}
+    if joint_damping is not None:
+        for index in plant.GetJointActuatorIndices():  # by instance: empty before Finalize
+            actuator = plant.get_joint_actuator(index)
+            if actuator.model_instance() != robot.model_instance:
+                continue
+            joint = actuator.joint()
+            added[joint.name()] = joint_damping(joint.name())
+            joint.set_default_damping(joint.default_damping() + added[joint.name()])
     parser = Parser(plant)
     (floor,) = add_sdf(parser, model_file("floor.sdf"))
     # One model with a frame 'chair' (config.validate parsed a user's file so).
@@ -179,7 +195,7 @@ def add_scene(
     scene_graph.collision_filter_manager().Apply(
         CollisionFilterDeclaration().ExcludeWithin(robot_geometries)
     )
-    scene = Scene(plant, scene_graph, robot, seated, helper, alone)
+    scene = Scene(plant, scene_graph, robot, seated, helper, alone, added_damping=added)
     scene.standing = StandingGeometry(scene, scenario.initial.base_rpy_rad[2])
     return scene
 

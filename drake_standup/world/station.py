@@ -27,6 +27,7 @@ Outputs
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,13 +96,17 @@ class Station:
 
 
 def make_station(
-    scenario: Scenario, feet: FeetReach, pd_gains: tuple[float, float] | None = None
+    scenario: Scenario,
+    feet: FeetReach,
+    pd_gains: tuple[float, float] | None = None,
+    joint_damping: Callable[[str], float] | None = None,
 ) -> Station:
     """The station of the module docstring; feet: how far the stand-up leans on the
     standing feet (for standing_pull_usage); pd_gains: Drake's joint PD on every actuator
-    (the seat-hold benchmark), with the desired_state input."""
+    (the seat-hold benchmark), with the desired_state input; joint_damping: the joints'
+    viscous friction beyond the URDF's (scene.add_scene; robot.hardware: icub)."""
     builder = DiagramBuilder()
-    scene = add_scene(builder, scenario, pd_gains=pd_gains)
+    scene = add_scene(builder, scenario, pd_gains=pd_gains, joint_damping=joint_damping)
     # The first check that needs the robot's geometry, before anything simulates.
     check_com_heights(scene, scenario)
     plant, robot = scene.plant, scene.robot

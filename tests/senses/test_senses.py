@@ -12,6 +12,7 @@ from pydrake.multibody.tree import MultibodyForces
 from pydrake.systems.framework import Diagram
 
 from drake_standup.config import ScenarioError, load_scenario
+from drake_standup.control.terms import RobotKinematics
 from drake_standup.robot.icub import velocity_start
 from drake_standup.robot.spatial import exp_rotation, rotation_vector
 from drake_standup.senses.hardware import FT_JOINTS, NOMINAL
@@ -251,8 +252,9 @@ def test_the_torque_loop_follows_a_step_as_its_first_order_lag(built):
 
 
 def test_friction_opposes_the_joints_velocity_by_the_identified_law(built):
-    """The plant's friction is -scale (Fc tanh(v / v_s) + Fv v) on each joint's velocity
-    index, nothing elsewhere."""
+    """The plant's friction is -scale Fc tanh(v / v_s) on each joint's velocity index,
+    nothing elsewhere, and its viscous part the joint's damping: the URDF's plus scale
+    Fv (the plant integrates it implicitly)."""
     muscles, hw, plant, instance, joints = _muscles(built)
     context = muscles.CreateDefaultContext()
     nq = plant.num_positions(instance)
@@ -265,10 +267,20 @@ def test_friction_opposes_the_joints_velocity_by_the_identified_law(built):
     v = state[rows]
     fv = np.array([hw.friction_of(n).viscous_Nms for n in joints.names])
     fc = np.array([hw.friction_of(n).coulomb_Nm for n in joints.names])
-    expected = -hw.friction_scale * (fc * np.tanh(v / muscles._vs) + fv * v)
+    expected = -hw.friction_scale * fc * np.tanh(v / muscles._vs)
     columns = plant.num_velocities() - plant.num_velocities(instance) + np.asarray(joints.v_index)
     np.testing.assert_allclose(tau[columns], expected, rtol=1e-12)
     assert not np.any(np.delete(tau, columns))
+    ideal = build_diagram(load_scenario()).station
+    for name, viscous in zip(joints.names, fv, strict=True):
+        urdf = ideal.plant.GetJointByName(name).default_damping()
+        damping = plant.GetJointByName(name).default_damping()
+        assert damping == pytest.approx(urdf + hw.friction_scale * viscous, rel=1e-12)
+    # The controller's model knows the URDF's damping only: the rest is the boards'.
+    scene = built.station.scene
+    own = RobotKinematics(plant, scene.robot, [], [], unknown_damping=scene.added_damping)._damping
+    urdf = RobotKinematics(ideal.plant, ideal.scene.robot, [], [])._damping
+    np.testing.assert_allclose(own, urdf, atol=1e-12)
 
 
 def test_the_estimate_at_rest_is_the_truth_within_the_sensors_resolution():
