@@ -95,8 +95,8 @@ class RobotEstimator(LeafSystem):
         self._touch = self._declare(6)
         self._pads_state = self._declare(3 * n_pads)
         self._last_wrenches = self._declare(6 * len(self._pieces.pieces))  # the last tick's
-        # [samples, sum of gyro (3), sum of accelerometer less gravity (3), done, biases (6)]
-        self._calibration = self._declare(14)
+        # [samples, sum of gyro (3), sum of accelerometer less gravity (3), done]
+        self._calibration = self._declare(8)
         self._encoders = self.DeclareVectorInputPort("encoder_positions", self._nj)
         self._velocities = self.DeclareVectorInputPort("encoder_velocities", self._nj)
         self._imu = self.DeclareVectorInputPort("imu", 6)
@@ -117,7 +117,7 @@ class RobotEstimator(LeafSystem):
         anchor = get(self._anchor).value().copy()
         q_j = self._encoders.Eval(context)
         calibration = get(self._calibration).value().copy()
-        imu = self._imu.Eval(context) - calibration[8:14]
+        imu = self._imu.Eval(context) - _biases(calibration)
         started = anchor[0] > 0.5
         v_prev = x_prev[self._nq :]
         v_j = self._velocities.Eval(context)
@@ -221,8 +221,11 @@ class RobotEstimator(LeafSystem):
             calibration[4:7] += imu[3:] - R_WS.T @ self._gravity
             return False
         calibration[7] = 1.0
-        calibration[8:14] = calibration[1:7] / max(calibration[0], 1.0)
         return True
+
+    def imu_biases(self, context: Context) -> np.ndarray:
+        """The IMU's biases [gyroscope (3), accelerometer (3)] as calibrated (0 until then)."""
+        return _biases(context.get_discrete_state(self._calibration).value())
 
     def _attitude_step(self, wxyz: np.ndarray, imu: np.ndarray, T: float) -> np.ndarray:
         """The attitude filter's next R_WS: the gyroscope's rotation over T, then a turn of
@@ -286,6 +289,13 @@ class RobotEstimator(LeafSystem):
             anchor[1] = other
             anchor[2:5] = X.translation()
             anchor[5:9] = X.rotation().ToQuaternion().wxyz()
+
+
+def _biases(calibration: np.ndarray) -> np.ndarray:
+    """The IMU's biases of a calibration state (_calibrate): the sums' means once done."""
+    if calibration[7] < 0.5:
+        return np.zeros(6)
+    return calibration[1:7] / max(calibration[0], 1.0)
 
 
 def _tilt_weight(hw: ICubHardware) -> float:

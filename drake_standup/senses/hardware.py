@@ -82,8 +82,7 @@ class ICubHardware:
     @property
     def latency_s(self) -> float:
         """From a tick's measurements to the middle of the tick its torques act over:
-        delay_ticks + 1/2 ticks (what the estimator predicts its state over, and the
-        CoM reference is taken ahead by)."""
+        delay_ticks + 1/2 ticks (what the estimator predicts its state over)."""
         return (self.delay_ticks + 0.5) * self.period_s
 
     def friction_of(self, joint: str) -> JointFriction:
