@@ -121,6 +121,13 @@ def make_standup_controller(
     scenario: Scenario, station: Station, plan: StandupPlan
 ) -> StandupController:
     """The diagram of the module docstring for the station's robot and its plan."""
+    systems = _standup_systems(scenario, station, plan)
+    diagram = _wired(systems)
+    return StandupController(diagram, systems["controller"].controller)
+
+
+def _standup_systems(scenario: Scenario, station: Station, plan: StandupPlan) -> dict:
+    """The diagram's systems by name (_WIRES' names)."""
     # The robot's own model: a helper's body is no part of it (scene.alone).
     scene = station.scene.alone or station.scene
     plant, robot = scene.plant, scene.robot
@@ -138,10 +145,17 @@ def make_standup_controller(
         station.arm_joints,
         braced_drop_m=station.braced_drop_m,
     )
-    # The joints' friction beyond the URDF's damping is the boards' to compensate (icub).
-    known = {"last_com": robot_last_com(station.scene), "unknown_damping": scene.added_damping}
-    model = ControllerModel(plant, robot, specs, config, period_s, **known)
-    systems = {
+    model = ControllerModel(
+        plant,
+        robot,
+        specs,
+        config,
+        period_s,
+        last_com=robot_last_com(station.scene),
+        # The joints' friction beyond the URDF's damping is the boards' to compensate (icub).
+        unknown_damping=scene.added_damping,
+    )
+    return {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()
         ),
@@ -175,6 +189,10 @@ def make_standup_controller(
             period_s,
         ),
     }
+
+
+def _wired(systems: dict) -> Diagram:
+    """systems connected by _WIRES, the rest of their inputs and _OUTPUTS exported."""
     builder = DiagramBuilder()
     for name, system in systems.items():
         builder.AddNamedSystem(name, system)
@@ -192,4 +210,4 @@ def make_standup_controller(
         builder.ExportOutput(systems[system].GetOutputPort(port), name)
     diagram = builder.Build()
     diagram.set_name("standup_controller")
-    return StandupController(diagram, systems["controller"].controller)
+    return diagram
