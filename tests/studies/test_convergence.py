@@ -404,3 +404,46 @@ def test_every_task_binds_to_its_function(tmp_path):
     assert len(tasks) == 2
     for _case, _key, fn, args in tasks:
         inspect.signature(fn).bind(*args)
+
+
+def test_a_fixed_controller_period_runs_every_step_against_the_1_ms_step_at_that_period():
+    """--controller-ms 10 (icub's 100 Hz): one case a step, the controller at 10 ms, each
+    judged against the 1 ms run at 10 ms (not a run with the controller at the step)."""
+    cases = study_cases(["assisted"], [1.0, 2.5, 5.0], controller_ms=10.0)
+    assert [(c.step_ms, c.controller_period_ms, c.factor) for c in cases] == [
+        (1.0, 10.0, 10),
+        (2.5, 10.0, 4),
+        (5.0, 10.0, 2),
+    ]
+    # The CoM 0.5 mm a ms of step off, and 8 mm at 5 ms: 5 ms fails the 5 mm bound.
+    shifts = {1.0: 0.0005, 2.5: 0.00125, 5.0: 0.008}
+    runs = {c: synthetic_run(com_shift_m=(shifts[c.step_ms], 0.0, 0.0)) for c in cases}
+    records = evaluate(cases, runs)
+    assert [r["reference"] for r in records] == [True, False, False]
+    deviations_mm = [r["errors"]["com_deviation_m"] * 1e3 for r in records]
+    assert deviations_mm == pytest.approx([0.0, 0.75, 7.5])
+    assert [r["pass"] for r in records] == [True, True, False]
+    choice = choose(records, ["assisted"])
+    assert (choice["step_ms"], choice["controller_period_ms"]) == (2.5, 10.0)
+
+
+@pytest.mark.parametrize("steps", [["3"], ["20"]])
+def test_a_step_that_does_not_divide_the_controller_period_is_one_error_line(
+    steps, tmp_path, capsys
+):
+    argv = ["--out", str(tmp_path), "--controller-ms", "10", "--steps-ms", "1", *steps]
+    assert main(argv) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith(f"error: --steps-ms: {steps[0]}; accepted: whole divisors")
+
+
+def test_under_icub_a_case_sets_the_hardwares_rate_and_step():
+    """Under robot.hardware: icub the rate and the plant step are the hardware's
+    (config/rules.py refuses others): the case sets them there, and validates."""
+    from drake_standup.config import load_scenario, validate
+    from drake_standup.studies.convergence.runs import with_steps
+
+    scenario = with_steps(load_scenario("assisted", [("robot.hardware", "icub")]), 0.0025, 0.01)
+    validate(scenario)
+    assert (scenario.plant.time_step, scenario.controller_period_s) == (0.0025, 0.01)
+    assert (scenario.hardware.plant_time_step_s, scenario.hardware.rate_hz) == (0.0025, 100.0)

@@ -25,6 +25,9 @@ class Case:
     scenario: str
     step_ms: float
     factor: int = 1  # controller period = factor * plant step
+    # The study's one controller period (--controller-ms), whatever the step: the robot's
+    # own rate (robot.hardware: icub runs at 100 Hz). None: the period follows the step.
+    rate_ms: float | None = None
 
     @property
     def name(self) -> str:
@@ -43,16 +46,41 @@ class Case:
         return self.controller_period_ms / 1000.0
 
 
-def study_cases(scenarios: list[str], steps_ms: list[float]) -> list[Case]:
+def study_cases(
+    scenarios: list[str], steps_ms: list[float], controller_ms: float | None = None
+) -> list[Case]:
     """Every scenario at every step (controller at the step), plus the
-    slow-controller variants at the steps of SLOW_CONTROLLER_STEPS_MS."""
+    slow-controller variants at the steps of SLOW_CONTROLLER_STEPS_MS; with
+    controller_ms, the controller at that period at every step instead (each step a
+    whole divisor of it: steps_divide)."""
     cases = []
     for name in scenarios:
         for step in sorted(steps_ms):
+            if controller_ms is not None:
+                cases.append(Case(name, step, round(controller_ms / step), controller_ms))
+                continue
             cases.append(Case(name, step))
             if step in SLOW_CONTROLLER_STEPS_MS:
                 cases.append(Case(name, step, SLOW_CONTROLLER_FACTOR))
     return cases
+
+
+def steps_divide(steps_ms: list[float], controller_ms: float) -> float | None:
+    """The first step that is not a whole divisor of controller_ms (None: all are): the
+    plant reads the controller's torques only at its own steps."""
+    for step in steps_ms:
+        ratio = controller_ms / step
+        if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+            return step
+    return None
+
+
+def same_family(a: Case, b: Case) -> bool:
+    """b is one of the runs a is compared with: the same scenario, and the controller at
+    the study's fixed period or, without one, at the plant step."""
+    if a.scenario != b.scenario or a.rate_ms != b.rate_ms:
+        return False
+    return a.rate_ms is not None or b.factor == 1
 
 
 def scenario_duration_s(name: str, text: str) -> float:

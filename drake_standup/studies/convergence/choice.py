@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import statistics
 
-from drake_standup.studies.convergence.cases import REFERENCE_STEP_MS, Case
+from drake_standup.studies.convergence.cases import REFERENCE_STEP_MS, Case, same_family
 from drake_standup.studies.convergence.comparison import (
     BOUNDS,
     compare,
@@ -22,10 +22,7 @@ def evaluate(cases: list[Case], runs: dict[Case, RunData]) -> list[dict]:
     against it too (with_fine_reference): raw numbers, errors and passes."""
     records = []
     for case in cases:
-        own = sorted(
-            (c for c in cases if c.scenario == case.scenario and c.factor == 1),
-            key=lambda c: c.step_ms,
-        )
+        own = sorted((c for c in cases if same_family(case, c)), key=lambda c: c.step_ms)
         ref_case = next((c for c in own if c.step_ms == REFERENCE_STEP_MS), own[0])
         fine_case = own[0] if own[0].step_ms < ref_case.step_ms else None
         result = compare(runs[case], runs[ref_case])
@@ -41,6 +38,7 @@ def evaluate(cases: list[Case], runs: dict[Case, RunData]) -> list[dict]:
                 "step_ms": case.step_ms,
                 "controller_period_ms": case.controller_period_ms,
                 "factor": case.factor,
+                "fixed_rate": case.rate_ms is not None,
                 "run": case.name,
                 "reference": case == ref_case,
                 "fine": case == fine_case,
@@ -68,6 +66,9 @@ def config_table(records: list[dict]) -> list[dict]:
                 "step_ms": config[0],
                 "factor": config[1],
                 "controller_period_ms": config[0] * config[1],
+                # The study's own configuration (the controller at the step, or at the
+                # study's fixed period), not a slower controller variant.
+                "base": config[1] == 1 or all(r.get("fixed_rate") for r in sel),
                 "scenarios": sorted(r["scenario"] for r in sel),
                 "all_pass": all(r["pass"] for r in sel),
                 "all_pass_strict": all(r["strict_pass"] for r in sel),
@@ -102,7 +103,7 @@ def choose(records: list[dict], scenarios: list[str]) -> dict | None:
     failing_below = [
         r
         for r in config_table(records)
-        if REFERENCE_STEP_MS <= r["step_ms"] < step and r["factor"] == 1 and not r["all_pass"]
+        if REFERENCE_STEP_MS <= r["step_ms"] < step and r["base"] and not r["all_pass"]
     ]
     return {
         "step_ms": best["step_ms"],

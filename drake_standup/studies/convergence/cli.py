@@ -1,7 +1,7 @@
 """Time-step convergence study (issue 11): how coarse may the plant and controller step?
 
 drake-standup convergence [--out DIR] [--workers N] [--scenarios NAME ...]
-    [--steps-ms H ...] [--set KEY=VALUE ...] [--fresh] [--docs DIR]
+    [--steps-ms H ...] [--controller-ms P] [--set KEY=VALUE ...] [--fresh] [--docs DIR]
 
 A study, not a test. It simulates scenarios/NAME.yaml (assisted, unassisted,
 lateral and seated by default) with the plant stepped at each of 0.5, 1, 2, 4, 5, 8
@@ -27,6 +27,12 @@ pass or fail per bound, and the choice), OUT/convergence.md (the tables for the
 README) and OUT/convergence.png (the errors over their bounds and the speed
 against the step). --set changes every run's scenario alike (e.g.
 robot.reflected_inertia=all: does the motors' inertia let a larger step converge?).
+
+--controller-ms P keeps the controller at P at every plant step instead (no slower
+variants; each step a whole divisor of P) and compares each run with the 1 ms step at
+P: which plant step a controller at a robot's own rate needs. Under
+--set robot.hardware=icub the steps go to hardware.plant_time_step_s and P to
+hardware.rate_hz, e.g. --controller-ms 10 --steps-ms 1 2.5 5 (issue 49).
 """
 
 from __future__ import annotations
@@ -40,7 +46,7 @@ from pathlib import Path
 from drake_standup.config import SCENARIO_DIR, ScenarioError, parse_scenario
 from drake_standup.config.arguments import OneLineErrorParser, parse_set
 from drake_standup.config.inputs import check_output_dir
-from drake_standup.studies.convergence.cases import SCENARIOS, STEPS_MS
+from drake_standup.studies.convergence.cases import SCENARIOS, STEPS_MS, steps_divide
 from drake_standup.studies.convergence.report import fmt
 from drake_standup.studies.convergence.study import StudyResult, run_study
 
@@ -70,6 +76,7 @@ def main(
             address=args.address,
             fresh=args.fresh,
             overrides=overrides,
+            controller_ms=args.controller_ms,
         )
     except OSError as err:
         print(f"error: {err}", file=sys.stderr)
@@ -117,6 +124,14 @@ def _parser(prog: str) -> argparse.ArgumentParser:
         "(default: %(default)s)",
     )
     parser.add_argument(
+        "--controller-ms",
+        type=float,
+        default=None,
+        help="the controller at this period at every plant step (each a whole divisor of "
+        "it), compared with the 1 ms step at the same period: a robot's own rate, e.g. 10 "
+        "with --set robot.hardware=icub (default: the controller at the step)",
+    )
+    parser.add_argument(
         "--set",
         action="append",
         default=[],
@@ -137,6 +152,14 @@ def _options_error(args: argparse.Namespace) -> str | None:
     bad = [s for s in args.steps_ms if not (math.isfinite(s) and s > 0)]
     if bad:
         return f"--steps-ms: {bad[0]}; accepted: steps > 0 (ms)"
+    if args.controller_ms is not None:
+        step = steps_divide(args.steps_ms, args.controller_ms)
+        if step is not None:
+            return (
+                f"--steps-ms: {step:g}; accepted: whole divisors of --controller-ms "
+                f"({args.controller_ms:g}), e.g. {args.controller_ms / 2:g} or "
+                f"{args.controller_ms / 4:g}"
+            )
     shipped = sorted(p.stem for p in SCENARIO_DIR.glob("*.yaml"))
     unknown = [s for s in args.scenarios if s not in shipped]
     if unknown:

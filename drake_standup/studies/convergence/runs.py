@@ -21,6 +21,17 @@ def is_cached(run_dir: Path, inputs: dict) -> bool:
         return False
 
 
+def with_steps(scenario, step_s: float, controller_period_s: float):
+    """scenario with its plant step and controller period set; under robot.hardware: icub
+    through the hardware's rate and step, which decide them there (config/rules.py)."""
+    if scenario.robot.hardware == "icub":
+        scenario.hardware.plant_time_step_s = step_s
+        scenario.hardware.rate_hz = 1.0 / controller_period_s
+    scenario.plant.time_step = step_s
+    scenario.controller_period_s = controller_period_s
+    return scenario
+
+
 def run_case(
     scenario_text: str,
     where: str,
@@ -49,8 +60,7 @@ def run_case(
         (run_dir / name).unlink(missing_ok=True)
     try:
         scenario = parse_scenario(scenario_text, where, overrides)
-        scenario.plant.time_step = step_s
-        scenario.controller_period_s = controller_period_s
+        scenario = with_steps(scenario, step_s, controller_period_s)
         scenario.duration_s = duration_s
         validate(scenario)
         metrics = json_safe(simulate(scenario, run_dir, record=False, progress=False).metrics)

@@ -55,9 +55,11 @@ def run_study(
     fresh: bool = False,
     progress: bool = True,
     overrides: list | tuple = (),
+    controller_ms: float | None = None,
 ) -> StudyResult:
     """Simulates what OUT/runs/ does not hold yet, compares, chooses, reports;
-    overrides: (key path, value) pairs set in every run's scenario (--set)."""
+    overrides: (key path, value) pairs set in every run's scenario (--set);
+    controller_ms: the controller at this period at every step (--controller-ms)."""
     from drake_standup.outputs.json_files import write_json
     from drake_standup.studies.cluster import run_on_cluster
 
@@ -66,7 +68,7 @@ def run_study(
     runs_dir.mkdir(parents=True, exist_ok=True)
     texts = {s: (SCENARIO_DIR / f"{s}.yaml").read_text() for s in scenarios}
     durations = {s: scenario_duration_s(s, texts[s]) for s in scenarios}
-    cases = study_cases(scenarios, steps_ms)
+    cases = study_cases(scenarios, steps_ms, controller_ms)
     inputs = {c: case_inputs(c, texts[c.scenario], durations[c.scenario], overrides) for c in cases}
     todo = [c for c in cases if fresh or not is_cached(runs_dir / c.name, inputs[c])]
     # Longest first, so that two workers finish together.
