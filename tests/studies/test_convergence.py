@@ -406,7 +406,9 @@ def test_every_task_binds_to_its_function(tmp_path):
         inspect.signature(fn).bind(*args)
 
 
-def test_a_fixed_controller_period_runs_every_step_against_the_1_ms_step_at_that_period():
+def test_a_fixed_controller_period_runs_every_step_against_the_1_ms_step_at_that_period(
+    tmp_path,
+):
     """--controller-ms 10 (icub's 100 Hz): one case a step, the controller at 10 ms, each
     judged against the 1 ms run at 10 ms (not a run with the controller at the step)."""
     cases = study_cases(["assisted"], [1.0, 2.5, 5.0], controller_ms=10.0)
@@ -425,6 +427,9 @@ def test_a_fixed_controller_period_runs_every_step_against_the_1_ms_step_at_that
     assert [r["pass"] for r in records] == [True, True, False]
     choice = choose(records, ["assisted"])
     assert (choice["step_ms"], choice["controller_period_ms"]) == (2.5, 10.0)
+    assert "1 ms run (plant at 1 ms, the controller at 10 ms" in markdown(records, choice)
+    draw_figure(records, tmp_path / "fixed.png")
+    assert (tmp_path / "fixed.png").stat().st_size > 10_000
 
 
 @pytest.mark.parametrize("steps", [["3"], ["20"]])

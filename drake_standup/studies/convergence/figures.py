@@ -36,12 +36,17 @@ def draw_figure(records: list[dict], path: Path) -> None:
     fig, axes = plt.subplots(2, 4, figsize=(15, 7.2), sharex=True)
     axes = axes.ravel()
 
+    def kind(r: dict) -> int:
+        """1: the study's own configuration (the controller at the step, or at the
+        --controller-ms period throughout); 2: the controller at twice the step."""
+        return 1 if r.get("fixed_rate") or r["factor"] == 1 else 2
+
     def series(scenario: str, factor: int, value, with_reference: bool) -> tuple[list, list]:
         sel = [
             r
             for r in records
             if r["scenario"] == scenario
-            and r["factor"] == factor
+            and kind(r) == factor
             and (with_reference or not r.get("reference"))
         ]
         sel.sort(key=lambda r: r["step_ms"])
@@ -81,7 +86,8 @@ def draw_figure(records: list[dict], path: Path) -> None:
     ax.set_title("speed: simulated s / wall s", fontsize=10)
     ax.set_ylim(bottom=0)
     _step_axes(axes, steps)
-    _legend_and_note(fig, scenarios, colors)
+    fixed = sorted({r["controller_period_ms"] for r in records if r.get("fixed_rate")})
+    _legend_and_note(fig, scenarios, colors, fixed[0] if fixed else None)
     fig.tight_layout(rect=(0, 0.02, 1, 0.95))
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -112,17 +118,24 @@ def _step_axes(axes, steps: list[float]) -> None:
         ax.set_xlabel("plant step (ms)")
 
 
-def _legend_and_note(fig, scenarios: list[str], colors: dict[str, str]) -> None:
+def _legend_and_note(
+    fig, scenarios: list[str], colors: dict[str, str], controller_ms: float | None
+) -> None:
     """The legend (scenarios, controller periods, bound) on top, what the axes' ends mean
-    below."""
+    below; controller_ms: the study's fixed controller period (--controller-ms), if any."""
     from matplotlib.lines import Line2D
 
     handles = [Line2D([], [], color=colors[s], marker="o", label=s) for s in scenarios]
-    handles += [
-        Line2D([], [], color="k", marker="o", label="controller at the plant step"),
-        Line2D([], [], color="k", marker="s", mfc="none", ls="none", label="controller at 2x"),
-        Line2D([], [], color="red", ls="--", label="bound (issue 11)"),
-    ]
+    if controller_ms is None:
+        handles += [
+            Line2D([], [], color="k", marker="o", label="controller at the plant step"),
+            Line2D([], [], color="k", marker="s", mfc="none", ls="none", label="controller at 2x"),
+        ]
+    else:
+        handles.append(
+            Line2D([], [], color="k", marker="o", label=f"controller at {controller_ms:g} ms")
+        )
+    handles.append(Line2D([], [], color="red", ls="--", label="bound (issue 11)"))
     fig.legend(handles=handles, loc="upper center", ncol=len(handles), fontsize=9, frameon=False)
     fig.text(
         0.5,

@@ -37,8 +37,14 @@ def markdown(
     if overrides:
         settings = ", ".join(f"`{path}={value}`" for path, value in overrides)
         lines += [f"Every run with {settings} (`--set`).", ""]
+    fixed = sorted({r["controller_period_ms"] for r in records if r.get("fixed_rate")})
+    reference = (
+        f"plant at 1 ms, the controller at {fixed[0]:g} ms as in every run (--controller-ms)"
+        if fixed
+        else "plant and controller at 1 ms"
+    )
     lines += [
-        "Each run against the same scenario's 1 ms run (plant and controller at 1 ms). "
+        f"Each run against the same scenario's 1 ms run ({reference}). "
         "Bounds (issue 11): stand-up time within max(2%, 0.03 s), state entries within "
         "0.05 s, CoM within 5 mm at every logged instant, final CoM within 2 mm, seated "
         "pad-group load shares within 5%, peak torque within 15%, no more 5 N load/unload "
