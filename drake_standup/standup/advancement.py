@@ -128,30 +128,20 @@ def psi_dot_law(
     return 1.0 + weight * (min(config.psi_dot_upper, max(1.0, ratio)) - 1.0), alpha
 
 
-class TrajectoryAdvancement(LeafSystem):
-    """Inputs com_W, com_velocity_W, omega_f_W, x_d_W, path_tangent_W (3 each),
-    path_progress (1), advances (1: the phase lets psi advance, phases.py) and response
-    (1: the response code; any but advancement's holds psi = t).
+class AdvancementLaw(LeafSystem):
+    """The law alone, without state: inputs com_W, com_velocity_W, omega_f_W, x_d_W,
+    path_tangent_W (3 each), path_progress (1), advances (1: the phase lets psi advance,
+    phases.py) and response (1: the response code; any but advancement's holds psi = t);
+    outputs psi_dot_law (the law's value) and alpha (1 each). Under icub the law on the
+    truth beside the robot's (sim/diagram.py) is one: logged, never integrated."""
 
-    Continuous state [psi, psi_dot]: the law sets the rate psi_dot tends to,
-    with time constant psi_ddot_filter_s, and psi integrates psi_dot. The
-    law jumps where it saturates or its gates switch (1 -> 2.5 and back);
-    a reference that followed it would jump in velocity, and its end-of-path
-    deceleration at psi_dot 2.5 -> 1 lifted the erect robot off its feet
-    (measured). So xd_dot is continuous and psi_ddot, which the reference's
-    feed-forward acceleration needs, is the exact derivative of the rate it
-    uses. psi_dot stays within [1, psi_dot_upper] (a first-order lag of a
-    signal in that range), and psi = t exactly while the law says 1.
-    Outputs psi, psi_dot, psi_ddot, alpha (1 each), and psi_dot_law (the
-    law's value, the target of psi_dot).
-    """
-
-    def __init__(self, config: AdvancementConfig):
+    def __init__(self, config: AdvancementConfig, *, declare_outputs: bool = True):
+        """declare_outputs False: a subclass declares them after its own (the ports'
+        order: psi, psi_dot, psi_ddot, psi_dot_law, alpha)."""
         super().__init__()
         if config.alpha_full_mps2 is None:
             raise ValueError("advancement.alpha_full_mps2 is None: resolve it with for_robot")
         self._config = config
-        self.DeclareContinuousState(BasicVector([0.0, 1.0]))
         self._com = self.DeclareVectorInputPort("com_W", 3)
         self._v = self.DeclareVectorInputPort("com_velocity_W", 3)
         self._omega_f = self.DeclareVectorInputPort("omega_f_W", 3)
@@ -164,12 +154,6 @@ class TrajectoryAdvancement(LeafSystem):
         # which a backward pull helps (docs/design.md).
         self._advances = self.DeclareVectorInputPort("advances", 1)
         self._response = self.DeclareVectorInputPort("response", 1)
-        self.DeclareVectorOutputPort(
-            "psi",
-            1,
-            self._CalcPsi,
-            prerequisites_of_calc={self.all_state_ticket()},
-        )
         # The law reads the inputs only: evaluated once per change of them,
         # however many outputs and integrator stages ask.
         inputs = {
@@ -186,16 +170,18 @@ class TrajectoryAdvancement(LeafSystem):
             )
         }
         self._law_cache = declare_cached(self, "psi_dot law", self._calc_law, inputs)
-        law = {self._law_cache.ticket()}
-        state = {self.all_state_ticket()}
-        self.DeclareVectorOutputPort("psi_dot", 1, self._CalcPsiDot, prerequisites_of_calc=state)
+        self._law_ticket = {self._law_cache.ticket()}
+        if declare_outputs:
+            self._declare_law_outputs()
+
+    def _declare_law_outputs(self) -> None:
+        """psi_dot_law and alpha."""
         self.DeclareVectorOutputPort(
-            "psi_ddot", 1, self._CalcPsiDdot, prerequisites_of_calc=law | state
+            "psi_dot_law", 1, self._CalcPsiDotLaw, prerequisites_of_calc=self._law_ticket
         )
         self.DeclareVectorOutputPort(
-            "psi_dot_law", 1, self._CalcPsiDotLaw, prerequisites_of_calc=law
+            "alpha", 1, self._CalcAlpha, prerequisites_of_calc=self._law_ticket
         )
-        self.DeclareVectorOutputPort("alpha", 1, self._CalcAlpha, prerequisites_of_calc=law)
 
     def _law(self, context: Context) -> tuple[float, float]:
         return self._law_cache.Eval(context)
@@ -217,6 +203,40 @@ class TrajectoryAdvancement(LeafSystem):
             lambda: self._progress.Eval(context)[0],
         )
 
+    def _CalcPsiDotLaw(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self._law(context)[0])
+
+    def _CalcAlpha(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self._law(context)[1])
+
+
+class TrajectoryAdvancement(AdvancementLaw):
+    """AdvancementLaw's inputs, and psi integrated.
+
+    Continuous state [psi, psi_dot]: the law sets the rate psi_dot tends to,
+    with time constant psi_ddot_filter_s, and psi integrates psi_dot. The
+    law jumps where it saturates or its gates switch (1 -> 2.5 and back);
+    a reference that followed it would jump in velocity, and its end-of-path
+    deceleration at psi_dot 2.5 -> 1 lifted the erect robot off its feet
+    (measured). So xd_dot is continuous and psi_ddot, which the reference's
+    feed-forward acceleration needs, is the exact derivative of the rate it
+    uses. psi_dot stays within [1, psi_dot_upper] (a first-order lag of a
+    signal in that range), and psi = t exactly while the law says 1.
+    Outputs psi, psi_dot, psi_ddot, alpha (1 each), and psi_dot_law (the
+    law's value, the target of psi_dot).
+    """
+
+    def __init__(self, config: AdvancementConfig):
+        super().__init__(config, declare_outputs=False)
+        self.DeclareContinuousState(BasicVector([0.0, 1.0]))
+        state = {self.all_state_ticket()}
+        self.DeclareVectorOutputPort("psi", 1, self._CalcPsi, prerequisites_of_calc=state)
+        self.DeclareVectorOutputPort("psi_dot", 1, self._CalcPsiDot, prerequisites_of_calc=state)
+        self.DeclareVectorOutputPort(
+            "psi_ddot", 1, self._CalcPsiDdot, prerequisites_of_calc=self._law_ticket | state
+        )
+        self._declare_law_outputs()
+
     def _psi_ddot(self, context: Context) -> float:
         """psi_ddot = (law - psi_dot) / psi_ddot_filter_s; exactly 0 while both are 1."""
         psi_dot = context.get_continuous_state_vector().GetAtIndex(1)
@@ -236,9 +256,3 @@ class TrajectoryAdvancement(LeafSystem):
 
     def _CalcPsiDdot(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, self._psi_ddot(context))
-
-    def _CalcPsiDotLaw(self, context: Context, output: BasicVector) -> None:
-        output.SetAtIndex(0, self._law(context)[0])
-
-    def _CalcAlpha(self, context: Context, output: BasicVector) -> None:
-        output.SetAtIndex(0, self._law(context)[1])
