@@ -21,7 +21,14 @@ from drake_standup.config.loading import (
     load_scenario,
     parse_scenario,
 )
-from drake_standup.config.rules import JOINT_TABLES, RULES, Range, validate, with_hardware
+from drake_standup.config.rules import (
+    JOINT_TABLES,
+    RULES,
+    Range,
+    is_whole_multiple,
+    validate,
+    with_hardware,
+)
 from drake_standup.config.scenario import (
     DEFAULT_SCENARIO,
     EFFORT_LIMIT_NM,
@@ -80,4 +87,5 @@ __all__ = [
     "read_text_file",
     "validate",
     "with_hardware",
+    "is_whole_multiple",
 ]

@@ -285,6 +285,13 @@ def _check_names(scenario: Scenario, data: dict, names: ModelNames) -> None:
         )
 
 
+def is_whole_multiple(period: float, step: float) -> bool:
+    """period is step times a whole number >= 1 (to round-off): a controller period the
+    plant's step grid carries (the plant reads its actuation input only at its steps)."""
+    ratio = period / step
+    return ratio >= 1.0 - 1e-9 and abs(ratio - round(ratio)) <= 1e-6
+
+
 def _check_across_fields(scenario: Scenario) -> None:
     """What one value says of another: the controller's period on the plant's step grid,
     the pulls' ramps, the reactive helper's path and leads."""
@@ -294,8 +301,7 @@ def _check_across_fields(scenario: Scenario) -> None:
     step, period = scenario.plant.time_step, scenario.controller_period_s
     if scenario.robot.hardware == "icub":
         _check_hardware_rate(scenario)
-    ratio = period / step
-    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+    if not is_whole_multiple(period, step):
         raise ScenarioError(
             f"controller_period_s: {period}; accepted: a whole multiple of plant.time_step "
             f"({step}), e.g. {step} or {2 * step}"

@@ -204,6 +204,7 @@ def _records(fails: set[tuple[str, float, int]], wall_2x: float = 0.5) -> list[d
                 "scenario": c.scenario,
                 "step_ms": c.step_ms,
                 "factor": c.factor,
+                "base": c.base,
                 "controller_period_ms": c.controller_period_ms,
                 "pass": passed,
                 "failed": [] if passed else ["com_deviation"],

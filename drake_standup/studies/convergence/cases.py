@@ -30,6 +30,12 @@ class Case:
     rate_ms: float | None = None
 
     @property
+    def base(self) -> bool:
+        """The study's own configuration: the controller at the step, or at the study's
+        fixed period (rate_ms) throughout; not the slower-controller variant."""
+        return self.rate_ms is not None or self.factor == 1
+
+    @property
     def name(self) -> str:
         return f"{self.scenario}_{self.step_ms:g}_{self.factor}"
 
@@ -66,21 +72,16 @@ def study_cases(
 
 
 def steps_divide(steps_ms: list[float], controller_ms: float) -> float | None:
-    """The first step that is not a whole divisor of controller_ms (None: all are): the
-    plant reads the controller's torques only at its own steps."""
-    for step in steps_ms:
-        ratio = controller_ms / step
-        if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
-            return step
-    return None
+    """The first step that is not a whole divisor of controller_ms (None: all are)."""
+    from drake_standup.config import is_whole_multiple
+
+    return next((s for s in steps_ms if not is_whole_multiple(controller_ms, s)), None)
 
 
 def same_family(a: Case, b: Case) -> bool:
-    """b is one of the runs a is compared with: the same scenario, and the controller at
-    the study's fixed period or, without one, at the plant step."""
-    if a.scenario != b.scenario or a.rate_ms != b.rate_ms:
-        return False
-    return a.rate_ms is not None or b.factor == 1
+    """b is one of the runs a is compared with: the same scenario and study, in the
+    study's own configuration (Case.base)."""
+    return a.scenario == b.scenario and a.rate_ms == b.rate_ms and b.base
 
 
 def scenario_duration_s(name: str, text: str) -> float:

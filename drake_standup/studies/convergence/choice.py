@@ -38,7 +38,8 @@ def evaluate(cases: list[Case], runs: dict[Case, RunData]) -> list[dict]:
                 "step_ms": case.step_ms,
                 "controller_period_ms": case.controller_period_ms,
                 "factor": case.factor,
-                "fixed_rate": case.rate_ms is not None,
+                "rate_ms": case.rate_ms,
+                "base": case.base,
                 "run": case.name,
                 "reference": case == ref_case,
                 "fine": case == fine_case,
@@ -47,6 +48,11 @@ def evaluate(cases: list[Case], runs: dict[Case, RunData]) -> list[dict]:
             }
         )
     return records
+
+
+def study_rate_ms(records: list[dict]) -> float | None:
+    """The study's fixed controller period (--controller-ms), or None."""
+    return next((r["rate_ms"] for r in records if r.get("rate_ms") is not None), None)
 
 
 def median_or_none(values) -> float | None:
@@ -66,9 +72,7 @@ def config_table(records: list[dict]) -> list[dict]:
                 "step_ms": config[0],
                 "factor": config[1],
                 "controller_period_ms": config[0] * config[1],
-                # The study's own configuration (the controller at the step, or at the
-                # study's fixed period), not a slower controller variant.
-                "base": config[1] == 1 or all(r.get("fixed_rate") for r in sel),
+                "base": all(r["base"] for r in sel),
                 "scenarios": sorted(r["scenario"] for r in sel),
                 "all_pass": all(r["pass"] for r in sel),
                 "all_pass_strict": all(r["strict_pass"] for r in sel),

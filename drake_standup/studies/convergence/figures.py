@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from drake_standup.studies.convergence.choice import study_rate_ms
+
 PANELS = (
     ("standup_time", "stand-up time error / max(2%, 0.03 s)"),
     ("state_entries", "state entry error / 0.05 s"),
@@ -36,17 +38,12 @@ def draw_figure(records: list[dict], path: Path) -> None:
     fig, axes = plt.subplots(2, 4, figsize=(15, 7.2), sharex=True)
     axes = axes.ravel()
 
-    def kind(r: dict) -> int:
-        """1: the study's own configuration (the controller at the step, or at the
-        --controller-ms period throughout); 2: the controller at twice the step."""
-        return 1 if r.get("fixed_rate") or r["factor"] == 1 else 2
-
     def series(scenario: str, factor: int, value, with_reference: bool) -> tuple[list, list]:
         sel = [
             r
             for r in records
             if r["scenario"] == scenario
-            and kind(r) == factor
+            and (1 if r["base"] else 2) == factor  # 2: the controller at twice the step
             and (with_reference or not r.get("reference"))
         ]
         sel.sort(key=lambda r: r["step_ms"])
@@ -86,8 +83,7 @@ def draw_figure(records: list[dict], path: Path) -> None:
     ax.set_title("speed: simulated s / wall s", fontsize=10)
     ax.set_ylim(bottom=0)
     _step_axes(axes, steps)
-    fixed = sorted({r["controller_period_ms"] for r in records if r.get("fixed_rate")})
-    _legend_and_note(fig, scenarios, colors, fixed[0] if fixed else None)
+    _legend_and_note(fig, scenarios, colors, study_rate_ms(records))
     fig.tight_layout(rect=(0, 0.02, 1, 0.95))
     fig.savefig(path, dpi=110)
     plt.close(fig)

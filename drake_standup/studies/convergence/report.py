@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from drake_standup.studies.convergence.choice import config_table, median_or_none
+from drake_standup.studies.convergence.choice import config_table, median_or_none, study_rate_ms
 
 
 def fmt(value, scale: float = 1.0, digits: int = 2) -> str:
@@ -37,10 +37,10 @@ def markdown(
     if overrides:
         settings = ", ".join(f"`{path}={value}`" for path, value in overrides)
         lines += [f"Every run with {settings} (`--set`).", ""]
-    fixed = sorted({r["controller_period_ms"] for r in records if r.get("fixed_rate")})
+    rate_ms = study_rate_ms(records)
     reference = (
-        f"plant at 1 ms, the controller at {fixed[0]:g} ms as in every run (--controller-ms)"
-        if fixed
+        f"plant at 1 ms, the controller at {rate_ms:g} ms as in every run (--controller-ms)"
+        if rate_ms is not None
         else "plant and controller at 1 ms"
     )
     lines += [

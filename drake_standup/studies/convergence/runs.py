@@ -24,9 +24,12 @@ def is_cached(run_dir: Path, inputs: dict) -> bool:
 def with_steps(scenario, step_s: float, controller_period_s: float):
     """scenario with its plant step and controller period set; under robot.hardware: icub
     through the hardware's rate and step, which decide them there (config/rules.py)."""
+    from drake_standup.config import with_hardware
+
     if scenario.robot.hardware == "icub":
         scenario.hardware.plant_time_step_s = step_s
         scenario.hardware.rate_hz = 1.0 / controller_period_s
+        return with_hardware(scenario)
     scenario.plant.time_step = step_s
     scenario.controller_period_s = controller_period_s
     return scenario
