@@ -330,9 +330,10 @@ def unknown_citations(path: Path, text: str | None = None) -> list[str]:
 
 def outside_citations(path: Path, text: str | None = None) -> list[str]:
     """Citations of the team's brief outside the repository (SPEC 3, SPEC section 9,
-    ../shared/): a reader cannot follow them."""
+    "SPEC:", ../shared/): a reader cannot follow them. SPEC as a word in capitals is the
+    brief whatever follows it."""
     text = prose(path) if text is None else text
-    return re.findall(r"\bSPEC(?:\s+section)?\s+\d+|\.\./shared/\S*", text)
+    return re.findall(r"\bSPEC\b(?:\s+section)?(?:\s+\d+)?|\.\./shared/\S*", text)
 
 
 def scenario_block(document: Path, section: str) -> str:

@@ -142,6 +142,11 @@ def test_the_checks_find_a_name_broken_on_purpose(tmp_path):
         "SPEC 3",
         "../shared/SPEC.md)",
     ]
+    assert outside_citations(doc, "the sensors (SPEC: the URDF's), SPEC section 11") == [
+        "SPEC",
+        "SPEC section 11",
+    ]
+    assert outside_citations(doc, "a spec, the Spec, SPECS of a motor") == []
     assert named_commits("at 745f4cd, not 1234567 nor abcdefa") == {"745f4cd"}
     assert docs_check.slug("Issue 46, fifth part: the soles' last slaps") == (
         "issue-46-fifth-part-the-soles-last-slaps"

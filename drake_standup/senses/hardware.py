@@ -13,8 +13,9 @@ from dataclasses import dataclass
 
 from drake_standup.config import HardwareConfig
 
-# The six F/T sensors of the icub-models URDFs: the fixed joints they sit on (SPEC: the
-# <sensor type="force_torque"> elements of iCubGazeboV2_5), upper arms, upper legs, feet.
+# The six F/T sensors of the icub-models URDFs: the fixed joints they sit on (the
+# <sensor type="force_torque"> elements of iCubGazeboV2_5, [icub-models]; [icub-tech]),
+# upper arms, upper legs, feet.
 FT_JOINTS = (
     "l_arm_ft_sensor",
     "r_arm_ft_sensor",
