@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drake_standup.outputs.signals import group_normal_forces
+from drake_standup.outputs.signals import group_mean_normal_forces
 from drake_standup.robot.limbs import JOINT_GROUPS, joint_group
 
 STATE_COLORS = {2: "tab:orange", 3: "tab:green", 4: "tab:purple"}
@@ -121,9 +121,10 @@ def figure_tracking(signals: dict[str, np.ndarray], entry_times_s, path: Path) -
         ax.plot(t, signals["com_W"][:, axis], color="tab:blue", label=f"CoM {name}")
         ax.set_ylabel(f"CoM {name} [m]")
         ax.legend(fontsize=8)
-    for group, fz in group_normal_forces(signals).items():
+    # Each sample the mean over the log period before it: a slap shows whatever the step.
+    for group, fz in group_mean_normal_forces(signals).items():
         ax_f.plot(t, fz, label=group)
-    ax_f.set_ylabel("normal force [N]")
+    ax_f.set_ylabel("normal force [N]\n(mean per log period)")
     ax_f.legend(fontsize=8)
     _plot_limb_speeds(ax_v, signals)
     ax_v.set_xlabel("time [s]")

@@ -7,7 +7,7 @@ import numpy as np
 
 from drake_standup.helper.work import HELPER_SPENT
 from drake_standup.outputs.estimation import estimation_metrics
-from drake_standup.outputs.signals import group_normal_forces
+from drake_standup.outputs.signals import group_mean_normal_forces, group_normal_forces
 from drake_standup.robot.limbs import JOINT_GROUPS, joint_group, shoulder_tendon_margin_rad
 
 
@@ -250,12 +250,13 @@ def smoothness_metrics(
 ) -> dict:
     """How smoothly the feet take the load, and whether the CoM reference jumps.
 
-    sole_force_chatter_N: the soles' summed normal force's largest departure from its
-    centred window_s moving average, from the stand-up's start (state 2's entry) to the
-    end; a heel or toe slapping down shows as one sample far off the average, a load
-    rising smoothly as none. com_reference_max_step_m: the largest distance between
-    consecutive logged samples of the CoM reference (log_period_s apart). None where the
-    run never left the seat or has too few samples."""
+    sole_force_chatter_N: the soles' summed normal force, each sample the mean over the
+    log period before it (the plant's impulse: signals.group_mean_normal_forces), its
+    largest departure from its centred window_s moving average, from the stand-up's start
+    (state 2's entry) to the end; a heel or toe slapping down shows as one sample far off
+    the average, a load rising smoothly as none. com_reference_max_step_m: the largest
+    distance between consecutive logged samples of the CoM reference (log_period_s
+    apart). None where the run never left the seat or has too few samples."""
     t = signals["time_s"]
     metrics: dict = {"sole_force_chatter_N": None, "com_reference_max_step_m": None}
     if len(t) < 2:
@@ -269,7 +270,7 @@ def smoothness_metrics(
         return metrics
     period = float(np.median(np.diff(t)))
     window = int(round(window_s / period)) | 1  # odd: centred
-    soles = group_normal_forces(signals).get("soles")
+    soles = group_mean_normal_forces(signals).get("soles")
     if soles is None:
         return metrics
     departure = moving_average_departure(soles, window)

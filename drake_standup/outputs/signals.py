@@ -48,8 +48,28 @@ def load_signals(path: Path) -> dict[str, np.ndarray]:
 def group_normal_forces(signals: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """Group name -> summed normal force of its pads over time, (N,) each, in
     the order the groups first appear in pad_groups."""
+    return _by_group(signals, signals["pad_normal_force_N"])
+
+
+def group_mean_normal_forces(signals: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Group name -> summed normal force of its pads averaged over the interval that ends
+    at each sample (the plant's impulse over it, pad_impulses_Ns, divided by its length;
+    the first sample's own force), (N,) each. Unlike a sample, the mean does not depend on
+    whether a one-step slap fell on a logged instant, nor on the plant's step
+    (docs/decisions/017-sole-force-measured.md). signals.npz before issue 60 has no
+    impulses: their samples."""
+    if "pad_impulses_Ns" not in signals:
+        return group_normal_forces(signals)
+    t = signals["time_s"]
+    mean = np.array(signals["pad_normal_force_N"], dtype=float, copy=True)
+    if len(t) > 1:
+        mean[1:] = np.diff(signals["pad_impulses_Ns"][:, :, 2], axis=0) / np.diff(t)[:, None]
+    return _by_group(signals, mean)
+
+
+def _by_group(signals: dict[str, np.ndarray], normal: np.ndarray) -> dict[str, np.ndarray]:
+    """Each pad group's columns of normal (samples x pads) summed, in pad_groups' order."""
     groups = [str(g) for g in signals["pad_groups"]]
-    normal = signals["pad_normal_force_N"]
     return {
         group: normal[:, [i for i, g in enumerate(groups) if g == group]].sum(axis=1)
         for group in dict.fromkeys(groups)
@@ -96,6 +116,7 @@ def _station_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.ndarr
         "pad_groups": np.array(list(station.pad_groups.values()), dtype=str),
         "pad_forces_W": pad_forces,
         "pad_normal_force_N": pad_forces[:, :, 2].copy(),
+        "pad_impulses_Ns": logs["pad_impulses_Ns"].reshape(len(t), len(station.pad_groups), 3),
         "base_quaternion_wxyz": state[:, 0:4],
         "base_position_W": state[:, 4:7],
         "joint_names": np.array(joints.names, dtype=str),

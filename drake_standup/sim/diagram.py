@@ -35,6 +35,7 @@ CONTROLLERS = ("whole_body", "seat_hold")
 STATION_SIGNALS = (
     "robot_state",
     "pad_forces_W",
+    "pad_impulses_Ns",
     "hand_wrenches_W",
     "com_W",
     "net_actuation",

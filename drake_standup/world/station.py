@@ -14,6 +14,7 @@ Inputs
 Outputs
     robot_state, net_actuation, contact_results, query_object
     pad_forces_W              (3 per pad) the contact force on each pad, world
+    pad_impulses_Ns           (3 per pad) int pad_forces_W dt over the plant's steps so far
     seat_pad_normal_forces_N  (3) normal force on the buttocks, left and right thigh pads
     pads_vertical_force_N     (1) the vertical force on all the robot's pads
     hand_wrenches_W           (12) the hands' sensors' wrenches (payloads.HAND_WRENCHES)
@@ -39,7 +40,7 @@ from drake_standup.config import Scenario
 from drake_standup.config.phases import SEAT_PAD_ROWS
 from drake_standup.ports.payloads import HAND_WRENCHES
 from drake_standup.robot.icub import ActuatedJoints, Robot, actuated_joints, arm_joint_names
-from drake_standup.world.pad_forces import ContactForceReporter
+from drake_standup.world.pad_forces import ContactForceReporter, PadImpulses
 from drake_standup.world.perturbations import NoisyWrenchSensor, PushSource
 from drake_standup.world.scene import (
     Scene,
@@ -127,6 +128,11 @@ def make_station(
     builder.ExportOutput(plant.get_contact_results_output_port(), "contact_results")
     builder.ExportOutput(scene.scene_graph.get_query_output_port(), "query_object")
     builder.ExportOutput(reporter.get_output_port(), "pad_forces_W")
+    impulses = builder.AddNamedSystem(
+        "pad_impulses", PadImpulses(len(pad_groups), scenario.plant.time_step)
+    )
+    builder.Connect(reporter.get_output_port(), impulses.get_input_port())
+    builder.ExportOutput(impulses.get_output_port(), "pad_impulses_Ns")
     if scene.helper is not None:
         _export_helper_ports(builder, plant, scene.helper.person.model_instance)
     if scenario.robot.hardware == "icub":

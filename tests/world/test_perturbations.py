@@ -83,6 +83,7 @@ DEFAULT_STATION = {
         "plant",
         "scene_graph",
         "contact_forces",
+        "pad_impulses",
         "seat_pad_normal_forces_N",
         "pads_vertical_force_N",
         "hand_wrench_sensor",

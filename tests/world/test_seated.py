@@ -63,6 +63,21 @@ def test_contact_forces_carry_the_robot_weight(seated_run):
         assert fz > 0.05 * weight, name
 
 
+def test_the_pads_impulse_is_the_weight_times_the_time(seated_run):
+    """At rest the pads' impulse over the plant's steps is m g T (the robot's momentum
+    does not change): over 1-5 s within 0.5 % of the URDF's weight times 4 s, and the
+    mean force over every 10 ms interval within 2 % of the weight (no interval counts
+    two or three of the 4 ms steps: 10 ms is 2.5 of them)."""
+    scenario, result, _ = seated_run
+    weight = _urdf_mass_kg(scenario.robot.model) * G
+    t = result.signals["time_s"]
+    vertical = result.signals["pad_impulses_Ns"][:, :, 2].sum(axis=1)
+    i, j = np.searchsorted(t, [1.0, 5.0])
+    assert vertical[j] - vertical[i] == pytest.approx(weight * (t[j] - t[i]), rel=0.005)
+    mean = np.diff(vertical[i : j + 1]) / np.diff(t[i : j + 1])
+    assert np.all(np.abs(mean - weight) < 0.02 * weight)
+
+
 def test_only_the_pads_touch_anything(seated_run):
     """The robot's only collision geometries are the five pads, and every one
     of them is in contact at the end (the pose really rests on chair and floor)."""
