@@ -365,15 +365,14 @@ class Scenario:
     # Simulated time. s.
     duration_s: float = 5.0
     # Drake's own plant settings: discrete 'similar' ([drake-docs]: 'lagged' and
-    # 'similar' ran 1.4-2.2x faster than real time, SAP 0.6x), stepped at 4 ms for
-    # speed: in the convergence study (python -m drake_standup.studies.convergence,
-    # docs/performance.md) 4 ms keeps every stand-up time within 0.04 s of 1 ms but
-    # fails the assisted CoM path's timing and, without motor inertia, the seated
-    # load split; 2 ms with robot.reflected_inertia all passes strictly. 1 ms:
-    # plant.time_step and controller_period_s both 0.001.
+    # 'similar' ran 1.4-2.2x faster than real time, SAP 0.6x), stepped at 2 ms under the
+    # controller's 4 ms: at 4 ms the soles' contact is not resolved (a heel landing or
+    # the thighs leaving the seat slap them, 175-281 N, where a 1 ms plant gives 40-61
+    # N); at 2 ms every case is within 15 N of the 1 ms plant's, for 1.4x the run time
+    # (docs/decisions/018-plant-step-resolves-the-soles.md). 1 ms: plant.time_step 0.001.
     plant: MultibodyPlantConfig = field(
         default_factory=lambda: MultibodyPlantConfig(
-            time_step=0.004,
+            time_step=0.002,
             discrete_contact_approximation="similar",
             contact_model="hydroelastic_with_fallback",
         )
@@ -410,9 +409,10 @@ class Scenario:
     phases: PhaseTable = field(default_factory=PhaseTable)
     # The momentum-based whole-body controller (drake_standup/control/controller.py).
     controller: ControllerConfig = field(default_factory=ControllerConfig)
-    # Its period: the plant's step (a whole multiple of it; a faster controller
-    # is wasted on a discrete plant). 250 Hz; the authors ran 100 Hz ([authors-code]).
-    # At twice the plant step the study found larger errors and no gain. s.
+    # Its period: a whole multiple of the plant's step (a faster controller is wasted on
+    # a discrete plant). 250 Hz, twice the plant's step: the plant at 1 ms under it
+    # stands up as under a 1 ms controller (decision 018); the authors ran 100 Hz
+    # ([authors-code]). s.
     controller_period_s: float = 0.004
     initial: InitialPose = field(default_factory=InitialPose)
     chair: ChairConfig = field(default_factory=ChairConfig)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from pydrake.multibody.tree import JacobianWrtVariable
 
-from drake_standup.config import SCENARIO_DIR, load_scenario
+from drake_standup.config import SCENARIO_DIR, Scenario, load_scenario
 from drake_standup.config.body import BodyHelperConfig
 from drake_standup.helper.body import (
     JOINT_IMPEDANCE,
@@ -56,7 +56,8 @@ def test_trunk_stiffness_is_the_measured_chest_stiffness_at_its_lever():
 @pytest.fixture(scope="module")
 def body_run():
     """The body scenario to 3.6 s (the pull from 3 s), logged at every plant step."""
-    scenario = load_scenario(BODY, [("duration_s", 3.6), ("log_period_s", 0.004)])
+    step = Scenario().plant.time_step
+    scenario = load_scenario(BODY, [("duration_s", 3.6), ("log_period_s", step)])
     run = prepare(scenario)
     start = _grips_and_hands(run)
     assert advance(run, scenario.duration_s), run.failure_reason

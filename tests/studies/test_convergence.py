@@ -50,6 +50,7 @@ def synthetic_run(
     entries: list | None = None,
     torque_Nm: float = 40.0,
     qp_failures: int = 0,
+    chatter_N: float | None = 30.0,
 ) -> RunData:
     """A run on the 10 ms grid: the CoM rises after t2, the pads carry
     seated_N before t2 and only the soles carry the weight after."""
@@ -78,6 +79,7 @@ def synthetic_run(
         "com_final_m": list(com[-1]),
         "max_abs_torque_Nm": torque_Nm,
         "qp_failures": qp_failures,
+        "sole_force_chatter_N": chatter_N,
         "realtime_factor": 1.0,
         "wall_time_s": duration_s,
     }
@@ -181,6 +183,19 @@ def test_torque_qp_failures_and_success_bounds():
     assert result["errors"]["peak_torque_rel"] == pytest.approx(7.0 / 40.0)
     assert result["failed"] == ["peak_torque", "qp_failures"]
     assert compare(ref, ref)["pass"]
+
+
+def test_the_sole_chatter_bound_is_15_N_of_the_reference():
+    """Issue 60: the soles' chatter means the same at a step as at 1 ms, within 15 N; a
+    run that never left the seat has none, which matches only a reference without any."""
+    ref = synthetic_run(chatter_N=40.0)
+    assert compare(synthetic_run(chatter_N=54.0), ref)["passes"]["sole_chatter"]
+    result = compare(synthetic_run(chatter_N=281.0), ref)
+    assert result["errors"]["sole_chatter_N"] == pytest.approx(241.0)
+    assert result["failed"] == ["sole_chatter"]
+    assert not compare(synthetic_run(chatter_N=None), ref)["passes"]["sole_chatter"]
+    none = synthetic_run(chatter_N=None)
+    assert compare(none, none)["passes"]["sole_chatter"]
 
 
 def test_a_run_without_signals_fails_what_needs_them():
@@ -361,7 +376,8 @@ def test_a_run_that_cannot_start_replaces_the_old_runs_files(tmp_path):
 def _verdict(com_mm: float, crossings: int = 0) -> dict:
     """A compare() result whose only errors are a CoM deviation and extra crossings."""
     normalised = dict.fromkeys(
-        ("standup_time", "state_entries", "com_final", "pad_split", "peak_torque"), 0.0
+        ("standup_time", "state_entries", "com_final", "pad_split", "peak_torque", "sole_chatter"),
+        0.0,
     )
     normalised["com_deviation"] = com_mm / (1e3 * COM_DEVIATION_M)
     passes = {k: v <= 1.0 for k, v in normalised.items()}

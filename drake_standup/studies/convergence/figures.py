@@ -17,6 +17,7 @@ PANELS = (
     ("com_final", "final CoM error / 2 mm"),
     ("pad_split", "seated load-share error / 5%"),
     ("peak_torque", "peak torque error / 15%"),
+    ("sole_chatter", "sole chatter error / 15 N"),
 )
 FLOOR, CEILING = 1e-3, 1e2  # the log axis' range; exact zeros and infinities land on its ends
 
@@ -35,7 +36,7 @@ def draw_figure(records: list[dict], path: Path) -> None:
     steps = sorted({r["step_ms"] for r in records})
     # Side by side, not on top of each other: a small shift per scenario.
     shift = {s: 1.0 + 0.025 * (i - (len(scenarios) - 1) / 2) for i, s in enumerate(scenarios)}
-    fig, axes = plt.subplots(2, 4, figsize=(15, 7.2), sharex=True)
+    fig, axes = plt.subplots(3, 3, figsize=(13, 10.5), sharex=True)
     axes = axes.ravel()
 
     def series(scenario: str, factor: int, value, with_reference: bool) -> tuple[list, list]:
@@ -73,11 +74,11 @@ def draw_figure(records: list[dict], path: Path) -> None:
     for ax, (key, title) in zip(axes, PANELS):
         plot(ax, lambda r, key=key: r["normalised"][key], log=True)
         _bound_panel(ax, records, key, title)
-    ax = axes[6]
+    ax = axes[len(PANELS)]
     plot(ax, lambda r: r["errors"]["extra_crossings"], log=False)
     ax.axhline(0.0, color="red", ls="--", lw=1)
     ax.set_title("extra 5 N load/unload crossings\n(worst pad group, vs 1 ms)", fontsize=10)
-    ax = axes[7]
+    ax = axes[len(PANELS) + 1]
     plot(ax, lambda r: r["raw"]["realtime_factor"], log=False, errors=False)
     ax.axhline(1.0, color="gray", ls=":", lw=1)
     ax.set_title("speed: simulated s / wall s", fontsize=10)
@@ -110,7 +111,7 @@ def _step_axes(axes, steps: list[float]) -> None:
         ax.set_xticklabels([f"{s:g}" for s in steps])
         ax.minorticks_off()
         ax.grid(alpha=0.3, which="both")
-    for ax in axes[4:]:
+    for ax in axes[-3:]:
         ax.set_xlabel("plant step (ms)")
 
 

@@ -47,7 +47,8 @@ def markdown(
         f"Each run against the same scenario's 1 ms run ({reference}). "
         "Bounds (issue 11): stand-up time within max(2%, 0.03 s), state entries within "
         "0.05 s, CoM within 5 mm at every logged instant, final CoM within 2 mm, seated "
-        "pad-group load shares within 5%, peak torque within 15%, no more 5 N load/unload "
+        "pad-group load shares within 5%, peak torque within 15%, the soles' chatter "
+        "(sole_force_chatter_N) within 15 N (issue 60), no more 5 N load/unload "
         "crossings in any pad group, no more QP failures, the same success. The seated "
         "scenario (5 s) is meant not to stand up. Crossings: load + unload events summed "
         "over the pad groups (the 1 ms run's in brackets); the bound holds per group and "
@@ -58,9 +59,10 @@ def markdown(
         "",
         "| scenario | plant / ctrl (ms) | stood up | stand-up (s) | stand-up err (s) | "
         "entries err (s) | max CoM dev (mm) | vs 0.5 ms | final CoM err (mm) | "
-        "seated split err (%) | vs 0.5 ms | peak torque err (%) | crossings (1 ms) | QP fails | "
+        "seated split err (%) | vs 0.5 ms | peak torque err (%) | sole chatter (N) | "
+        "chatter err (N) | crossings (1 ms) | QP fails | "
         "sim s / wall s | wall (s) | pass |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     refs = {r["scenario"]: r for r in records if r.get("reference")}
     lines += [_run_row(r, refs, records) for r in records]
@@ -112,6 +114,8 @@ def _run_row(r: dict, refs: dict[str, dict], records: list[dict]) -> str:
         f"{fmt(err['com_final_m'], 1e3, 1)} | {fmt(err['pad_split_pct'], digits=1)} | "
         f"{fmt(fine.get('pad_split_pct'), digits=1)} | "
         f"{fmt(err['peak_torque_rel'], 100.0, 1)} | "
+        f"{fmt(raw.get('sole_force_chatter_N'), digits=1)} | "
+        f"{fmt(err.get('sole_chatter_N'), digits=1)} | "
         f"{'-' if cross is None else cross} ({'-' if ref_cross is None else ref_cross}) | "
         f"{raw['qp_failures']} | {fmt(raw['realtime_factor'])} | "
         f"{fmt(raw['wall_time_s'], digits=0)} | {mark} |"
