@@ -368,8 +368,9 @@ class Scenario:
     # 'similar' ran 1.4-2.2x faster than real time, SAP 0.6x), stepped at 2 ms under the
     # controller's 4 ms: at 4 ms the soles' contact is not resolved (a heel landing or
     # the thighs leaving the seat slap them, 175-281 N, where a 1 ms plant gives 40-61
-    # N); at 2 ms every case is within 15 N of the 1 ms plant's, for 1.4x the run time
-    # (docs/decisions/018-plant-step-resolves-the-soles.md). 1 ms: plant.time_step 0.001.
+    # N); at 2 ms every case of the convergence study is within 15 N of the 1 ms plant's,
+    # for 1.4x the run time (docs/decisions/018-plant-step-resolves-the-soles.md).
+    # 1 ms: plant.time_step 0.001.
     plant: MultibodyPlantConfig = field(
         default_factory=lambda: MultibodyPlantConfig(
             time_step=0.002,
