@@ -49,6 +49,16 @@ class ControllerConfig:
     # ... softly: a slack s per joint at the cost w s^2 (rad/s^2); hard bounds made the
     # QP infeasible where the soles pin the legs or the pull holds the shoulders.
     joint_limit_weight: float = 1.0e3
+    # The arms' joints are held below this speed, softly (the same slack and weight): a
+    # pull stronger than the feet hold moves them at a person's pace, and they never whip
+    # back (control/tasks/joint_limits.py: speed_bounds; None: no bound). 0.4 below the
+    # 3 rad/s it is for: where the plant's arms do not follow the plan (the trunk jolted at
+    # a contact change) it is met only over its time constant: the margin is the overshoot
+    # measured under strong pulls (docs/decisions/019-arms-at-a-persons-pace.md). rad/s.
+    arm_speed_limit_rad_per_s: float | None = 2.6
+    # ... approached with this time constant (the barrier's; two of the 10 ms ticks of
+    # robot.hardware icub). s.
+    arm_speed_time_constant_s: float = 0.02
     # The shoulders' tendon-bound range, A q + b > 0 over pitch, roll and yaw (iCub 2.x:
     # icub-tech, "Range of Motion of the iCub Shoulders"; robot/limbs.py), held as the joint
     # limits are: soft rows with the same horizon, braking and weight.

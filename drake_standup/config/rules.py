@@ -105,6 +105,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "standup.standing_pull_usage_limit standup.gentle_pull_force_N "
         "controller.momentum_weight controller.*_time_constant_s "
         "controller.joint_limit_horizon_s controller.joint_braking_rad_per_s2 "
+        "controller.arm_speed_limit_rad_per_s "
         "controller.*friction_coefficient* "
         "controller.*_max_normal_force_N controller.torque_limit_Nm controller.help_* "
         "controller.mass_scale_bounds compliance.virtual_mass_kg compliance.stiffness_N_per_m "

@@ -118,6 +118,8 @@ def make_program(
             config.joint_braking_rad_per_s2,
             linear_limits=shoulder_tendon_limits(joints.names) if config.shoulder_tendons else None,
             num_velocities=plant.num_velocities(),
+            speed_limit_rad_per_s=_speed_limits(joints, config),
+            speed_time_constant_s=config.arm_speed_time_constant_s,
         ),
         soft_bound_weight=config.joint_limit_weight,
         solver=config.qp_solver,
@@ -192,6 +194,13 @@ def _tasks(
         if config.sole_moment_rate_weight_s > 0.0 and period_s > 0.0
         else []
     )
+
+
+def _speed_limits(joints: ControllerJoints, config: ControllerConfig) -> np.ndarray | None:
+    """Each joint's speed limit for JointLimitBounds: the arms' (None: none)."""
+    if config.arm_speed_limit_rad_per_s is None or joints.arms is None:
+        return None
+    return np.where(joints.arms, config.arm_speed_limit_rad_per_s, np.inf)
 
 
 def posture_weights(plant: MultibodyPlant, joints: ControllerJoints, config: ControllerConfig):

@@ -21,7 +21,7 @@ from drake_standup.control.mass import next_mass_state
 from drake_standup.control.pad_dynamics import PadCompliance
 from drake_standup.control.terms import RobotKinematics, RobotTerms
 from drake_standup.ports.payloads import HAND_WRENCHES
-from drake_standup.robot.icub import Robot, actuated_joints
+from drake_standup.robot.icub import Robot, actuated_joints, arm_joint_names
 
 HANDS = ("l_hand", "r_hand")
 _F_Z_LEFT = HAND_WRENCHES["f_l"].start + 2
@@ -97,6 +97,8 @@ class ControllerJoints:
     q_min: np.ndarray  # position limits, rad
     q_max: np.ndarray
     instance: object = None  # the robot's ModelInstanceIndex
+    # The arms' joints (robot/icub.py: arm_joint_names), a mask in actuator order (None: none).
+    arms: np.ndarray | None = None
 
     @classmethod
     def of(cls, plant: MultibodyPlant, robot: Robot) -> ControllerJoints:
@@ -109,6 +111,7 @@ class ControllerJoints:
             q_min=np.array([joint.position_lower_limits()[0] for joint in joints]),
             q_max=np.array([joint.position_upper_limits()[0] for joint in joints]),
             instance=robot.model_instance,
+            arms=np.isin(actuated.names, arm_joint_names(plant, robot)),
         )
 
 

@@ -27,8 +27,16 @@ class JointLimitBounds:
         *,
         linear_limits: tuple[np.ndarray, np.ndarray] | None = None,
         num_velocities: int | None = None,
+        speed_limit_rad_per_s: np.ndarray | None = None,
+        speed_time_constant_s: float = 0.05,
     ):
+        """speed_limit_rad_per_s: each joint's speed limit (inf: none; None: none), held
+        by speed_bounds with speed_time_constant_s."""
         self.v_indices = v_indices
+        self._speed = None
+        if speed_limit_rad_per_s is not None and np.isfinite(speed_limit_rad_per_s).any():
+            self._speed = np.asarray(speed_limit_rad_per_s, dtype=float)
+        self._speed_tau = speed_time_constant_s
         self._q, self._v = as_slice(q_indices), as_slice(v_indices)
         self._q_min, self._q_max = q_min, q_max
         self._horizon_s = horizon_s
@@ -44,6 +52,8 @@ class JointLimitBounds:
         """(vdot_min, vdot_max) at terms' state."""
         q, qdot = terms.q[self._q], terms.v[self._v]
         low, high = self._bounds(q, qdot, self._q_min, self._q_max)
+        if self._speed is not None:
+            low, high = speed_bounds(qdot, self._speed, self._speed_tau, low, high)
         if self.combined_rows is None:
             return low, high
         s, sdot = self._a @ q, self._a @ qdot
@@ -78,6 +88,25 @@ def joint_limit_acceleration_bounds(
     scale = 2.0 / horizon_s**2
     q_coasting = q + horizon_s * qdot
     return scale * (q_min - q_coasting), scale * (q_max - q_coasting)
+
+
+def speed_bounds(
+    qdot: np.ndarray,
+    speed_limit: np.ndarray,
+    time_constant_s: float,
+    low: np.ndarray,
+    high: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(low, high) tightened so that each joint's speed stays within speed_limit: the
+    margin m = v_max - |qdot| kept with dm/dt >= -m / T (a control barrier function of time
+    constant T), i.e. (-v_max - qdot) / T <= qddot <= (v_max - qdot) / T. A joint already
+    faster is brought back at that rate. The position bounds win where the two conflict (a
+    joint at its limit must stop whatever its speed)."""
+    speed_low = (-speed_limit - qdot) / time_constant_s
+    speed_high = (speed_limit - qdot) / time_constant_s
+    new_low = np.minimum(np.maximum(low, speed_low), high)
+    new_high = np.maximum(np.minimum(high, speed_high), new_low)
+    return new_low, new_high
 
 
 def braking_bounds(

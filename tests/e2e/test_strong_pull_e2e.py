@@ -1,0 +1,32 @@
+"""Arms that give way at a person's pace under a pull stronger than the feet hold
+(issue 60, slow): 30 and 35 N forward and up per hand for 6 s, the stand-up started by the
+clock and by the hands. Before the arms' speed bound the 30 N pull whipped a shoulder at
+5.4 rad/s (docs/decisions/019-arms-at-a-persons-pace.md)."""
+
+from __future__ import annotations
+
+import pytest
+
+from drake_standup.config import SCENARIO_DIR, Pull, load_scenario
+from drake_standup.sim.simulate import simulate
+
+pytestmark = pytest.mark.slow
+
+# The issue's bound on the arms' joint speed, rad/s.
+ARMS_RAD_PER_S = 3.0
+
+
+@pytest.mark.parametrize("trigger", ["time", "hands"])
+@pytest.mark.parametrize("force_N", [30.0, 35.0])
+def test_a_strong_pull_is_stood_into_without_whipping_the_arms(force_N, trigger):
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml")
+    scenario.standup.trigger = trigger
+    scenario.human.pulls = [
+        Pull(hand=hand, start_s=3.0, duration_s=6.0, ramp_s=0.5, force_N=[force_N, 0.0, force_N])
+        for hand in ("left", "right")
+    ]
+    assert scenario.controller.arm_speed_limit_rad_per_s < ARMS_RAD_PER_S
+    m = simulate(scenario, record=False, progress=False).metrics
+    assert m["success"], m["failure_reason"]
+    assert m["arms_braced_s"] > 1.0  # the pull is beyond what the reaching feet hold
+    assert m["peak_joint_speed_arms_rad_per_s"] <= ARMS_RAD_PER_S, m
