@@ -242,7 +242,7 @@ def _add_law_from_truth(
     )
     for name in ("com_W", "com_velocity_W", "omega_f_W"):
         builder.Connect(world.GetOutputPort(name), law.GetInputPort(name))
-    for name in ("x_d_W", "path_tangent_W", "path_progress", "advances"):
+    for name in ("x_d_W", "lean_W", "path_tangent_W", "path_progress", "advances"):
         builder.Connect(brain.GetOutputPort(name), law.GetInputPort(name))
     builder.Connect(outputs["response"], law.GetInputPort("response"))
     return {

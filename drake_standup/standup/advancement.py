@@ -51,6 +51,7 @@ from pydrake.systems.framework import BasicVector, Context, ContinuousState, Lea
 from drake_standup.config import AdvancementConfig
 from drake_standup.control.smooth import smoothstep
 from drake_standup.ports.caching import declare_cached
+from drake_standup.standup.com_path import leaned
 
 # The tangent of a phase that holds psi = t (read only).
 _NO_TANGENT = np.zeros(3)
@@ -73,10 +74,18 @@ def helpfulness(tangent: np.ndarray, omega_f: np.ndarray, eps: float) -> float:
     return float(tangent @ omega_f) / math.sqrt(t2)
 
 
-def lead(com: np.ndarray, x_d: np.ndarray, tangent: np.ndarray) -> float:
-    """How far the CoM is ahead of its reference along the path. m."""
+def lead(
+    com: np.ndarray, x_d: np.ndarray, tangent: np.ndarray, lean: np.ndarray | None = None
+) -> float:
+    """How far the CoM is ahead of its target along the path, m: of x_d leaned as the
+    controller leans it (com_path.leaned; None: not leaned). Against the bare x_d, the lean
+    the controller asks for read as a lag: braced, the CoM target stands 1.3 cm lower, and
+    the gate held psi = t through a rise the pull helped (issue 60's lagging partner)."""
     norm = float(np.linalg.norm(tangent))
-    return float((com - x_d) @ tangent) / norm if norm > 0.0 else 0.0
+    if norm <= 0.0:
+        return 0.0
+    target = x_d if lean is None else leaned(x_d, lean)
+    return float((com - target) @ tangent) / norm
 
 
 def psi_dot_law(
@@ -130,10 +139,11 @@ def psi_dot_law(
 
 class AdvancementLaw(LeafSystem):
     """The law alone, without state: inputs com_W, com_velocity_W, omega_f_W, x_d_W,
-    path_tangent_W (3 each), path_progress (1), advances (1: the phase lets psi advance,
-    phases.py) and response (1: the response code; any but advancement's holds psi = t);
-    outputs psi_dot_law (the law's value) and alpha (1 each). Under icub the law on the
-    truth beside the robot's (sim/diagram.py) is one: logged, never integrated."""
+    lean_W (optional), path_tangent_W (3 each), path_progress (1), advances (1: the phase
+    lets psi advance, phases.py) and response (1: the response code; any but
+    advancement's holds psi = t); outputs psi_dot_law (the law's value) and alpha (1
+    each). Under icub the law on the truth beside the robot's (sim/diagram.py) is one:
+    logged, never integrated."""
 
     def __init__(self, config: AdvancementConfig, *, declare_outputs: bool = True):
         """declare_outputs False: a subclass declares them after its own (the ports'
@@ -146,6 +156,8 @@ class AdvancementLaw(LeafSystem):
         self._v = self.DeclareVectorInputPort("com_velocity_W", 3)
         self._omega_f = self.DeclareVectorInputPort("omega_f_W", 3)
         self._x_d = self.DeclareVectorInputPort("x_d_W", 3)
+        # The controller's lean of x_d (3, com_path.leaned; unconnected: none), for the lead.
+        self._lean = self.DeclareVectorInputPort("lean_W", 3)
         self._tangent = self.DeclareVectorInputPort("path_tangent_W", 3)
         # How far along its segment the reference is (0-1), for the taper.
         self._progress = self.DeclareVectorInputPort("path_progress", 1)
@@ -163,6 +175,7 @@ class AdvancementLaw(LeafSystem):
                 self._v,
                 self._omega_f,
                 self._x_d,
+                self._lean,
                 self._tangent,
                 self._progress,
                 self._advances,
@@ -199,7 +212,12 @@ class AdvancementLaw(LeafSystem):
             lambda: self._v.Eval(context),
             self._omega_f.Eval(context),
             tangent,
-            lambda: lead(self._com.Eval(context), self._x_d.Eval(context), tangent),
+            lambda: lead(
+                self._com.Eval(context),
+                self._x_d.Eval(context),
+                tangent,
+                self._lean.Eval(context) if self._lean.HasValue(context) else None,
+            ),
             lambda: self._progress.Eval(context)[0],
         )
 

@@ -64,6 +64,25 @@ def path(segment: np.ndarray, psi: float) -> tuple[np.ndarray, np.ndarray, np.nd
     return x_start + delta * s, delta * ds / T, delta * dds / (T * T)
 
 
+def leaned(x_d: np.ndarray, lean: np.ndarray) -> np.ndarray:
+    """The CoM target's position x_d leaned by lean (3: forward, sideways, down).
+
+    Leaning is tilting about the feet: the target keeps its distance from the floor point
+    below the unleaned one, so it drops as it leans (2 cm at a 15 cm lean; an unchanged
+    height asked for legs longer than straight); lean[2] lowers it further (the arms
+    braced stand lower)."""
+    if not np.count_nonzero(lean):
+        return x_d
+    height = x_d[2]
+    return np.array(
+        [
+            x_d[0] + lean[0],
+            x_d[1] + lean[1],
+            math.sqrt(max(height * height - lean[0] ** 2 - lean[1] ** 2, 0.0)) + lean[2],
+        ]
+    )
+
+
 def height_follows(segment: np.ndarray) -> bool:
     """The segment's reference height is the measured CoM's (SEGMENT's height_follows)."""
     return bool(segment[_FOLLOWS] > 0.5)
@@ -225,14 +244,8 @@ class CoMTarget:
         lean filter's clock, as the posture's (never slower than time)."""
         lean = self._lean(terms, state, tau_hand, lean_W, psi_dot)
         if np.count_nonzero(lean):
-            # Leaning is tilting about the feet: the CoM target keeps its distance from
-            # the floor point below the unleaned target, so it drops as it leans (2 cm at
-            # a 15 cm lean); an unchanged height asked for legs longer than straight.
             com_reference = com_reference.copy()
-            height = com_reference[2]
-            com_reference[:2] += lean[:2]
-            com_reference[2] = math.sqrt(max(height * height - lean[0] ** 2 - lean[1] ** 2, 0.0))
-            com_reference[2] += lean[2]  # the arms braced stand lower
+            com_reference[:3] = leaned(com_reference[:3], lean)
         pulled = F_hand_W is not None and compliant
         next_compliance = compliance
         if pulled or np.count_nonzero(compliance):

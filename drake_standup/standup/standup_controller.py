@@ -67,6 +67,7 @@ _WIRES = [
     ("advancement", "com_velocity_W", "", "com_velocity_W"),
     ("advancement", "omega_f_W", "", "omega_f_W"),
     ("advancement", "x_d_W", "com_reference", "x_d_W"),
+    ("advancement", "lean_W", "controller", "lean_W"),
     ("advancement", "path_tangent_W", "com_reference", "path_tangent_W"),
     ("advancement", "path_progress", "com_reference", "path_progress"),
     ("advancement", "advances", "state_machine", "advances"),

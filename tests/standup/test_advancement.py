@@ -225,6 +225,26 @@ def test_lead_gate_waits_while_the_com_lags():
     assert psi_dot_law(CFG, v, omega_f, TANGENT, 0.001)[0] > 1.7
 
 
+def test_the_lead_is_measured_from_the_leaned_target():
+    """A CoM standing exactly where the controller leans its target (back 5 cm against a
+    pull, 1.3 cm lower with the arms braced) leads by 0 along a rising path, whatever
+    the lean: the leaned target keeps its distance from the floor point below x_d
+    (sqrt(h^2 - 0.05^2) - 0.013, worked out here). Against the bare x_d the same CoM
+    would read as 1.6 cm behind, past the 1.5 cm tolerance: psi held at t."""
+    x_d = np.array([0.226, 0.0, 0.45])
+    rising = np.array([0.0, 0.0, 0.3])
+    lean = np.array([-0.05, 0.0, -0.013])
+    com = np.array([0.176, 0.0, math.sqrt(0.45**2 - 0.05**2) - 0.013])
+    assert lead(com, x_d, rising, lean) == pytest.approx(0.0, abs=1e-12)
+    bare = lead(com, x_d, rising)
+    assert bare == pytest.approx(com[2] - 0.45)
+    assert bare < -GRADED.lag_tolerance_m
+    # 1 cm above the leaned target along the path: 1 cm of lead.
+    assert lead(com + [0.0, 0.0, 0.01], x_d, rising, lean) == pytest.approx(0.01)
+    # No lean: the bare x_d.
+    assert lead(com, x_d, rising, np.zeros(3)) == pytest.approx(bare)
+
+
 def _sensing_rig():
     """(plant, RobotSensing, its context, a plant context, the hand frames): the iCub
     without pads, finalized, its sensing with no heels."""
