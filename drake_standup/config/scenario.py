@@ -188,6 +188,13 @@ class AdvancementConfig:
     # the load (measured; at 5 mm state 3 and a braced rise never advanced). m.
     lead_gate: bool = True
     lag_tolerance_m: float = 0.015
+    # The lead measured from x_d as the controller leans it against the pull (the target
+    # it tracks) instead of the bare x_d: braced, that target stands 1.3 cm lower and the
+    # gate reads it as a lag. On, the lagging 26 N partner stands up in 3.60 s (4.04 s
+    # off; alone 3.70), but the faster rises slap the soles harder on the person's body
+    # (79 -> 130 N by the hands) and its run then depends on the plant's step
+    # (docs/decisions/020-lead-from-the-leaned-target.md): off until those are quiet.
+    lead_from_leaned_target: bool = False
     # psi_dot tends to the law's value with this time constant (psi integrates
     # it): the law jumps (1 -> 2.5 at a gate); a reference following it jumped
     # in velocity and lifted the erect robot off its feet (measured). s.

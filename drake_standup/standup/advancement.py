@@ -156,7 +156,8 @@ class AdvancementLaw(LeafSystem):
         self._v = self.DeclareVectorInputPort("com_velocity_W", 3)
         self._omega_f = self.DeclareVectorInputPort("omega_f_W", 3)
         self._x_d = self.DeclareVectorInputPort("x_d_W", 3)
-        # The controller's lean of x_d (3, com_path.leaned; unconnected: none), for the lead.
+        # The controller's lean of x_d (3, com_path.leaned; unconnected: none), for the lead
+        # where config.lead_from_leaned_target.
         self._lean = self.DeclareVectorInputPort("lean_W", 3)
         self._tangent = self.DeclareVectorInputPort("path_tangent_W", 3)
         # How far along its segment the reference is (0-1), for the taper.
@@ -216,10 +217,14 @@ class AdvancementLaw(LeafSystem):
                 self._com.Eval(context),
                 self._x_d.Eval(context),
                 tangent,
-                self._lean.Eval(context) if self._lean.HasValue(context) else None,
+                self._lean.Eval(context) if self._leaned(context) else None,
             ),
             lambda: self._progress.Eval(context)[0],
         )
+
+    def _leaned(self, context: Context) -> bool:
+        """The lead is measured from the leaned target (lead_from_leaned_target, connected)."""
+        return self._config.lead_from_leaned_target and self._lean.HasValue(context)
 
     def _CalcPsiDotLaw(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, self._law(context)[0])

@@ -15,6 +15,7 @@ from drake_standup.config import RESPONSES, AdvancementConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.robot.icub import ContactModel, add_icub
 from drake_standup.standup.advancement import (
+    AdvancementLaw,
     TrajectoryAdvancement,
     for_robot,
     lead,
@@ -243,6 +244,37 @@ def test_the_lead_is_measured_from_the_leaned_target():
     assert lead(com + [0.0, 0.0, 0.01], x_d, rising, lean) == pytest.approx(0.01)
     # No lean: the bare x_d.
     assert lead(com, x_d, rising, np.zeros(3)) == pytest.approx(bare)
+
+
+@pytest.mark.parametrize("leaned", [False, True])
+def test_the_law_reads_the_lean_only_where_asked(leaned):
+    """AdvancementLaw with the CoM where the controller leans its target on a rising path
+    (lean_W connected): with lead_from_leaned_target the gate sees no lag and the law
+    advances; without it the lean reads as a lag past the tolerance and psi_dot is 1."""
+    cfg = dataclasses.replace(GRADED, lead_from_leaned_target=leaned)
+    law = AdvancementLaw(cfg)
+    context = law.CreateDefaultContext()
+    rising = np.array([0.0, 0.0, 0.3])
+    x_d, lean = np.array([0.226, 0.0, 0.45]), np.array([-0.05, 0.0, -0.013])
+    com = np.array([0.176, 0.0, math.sqrt(0.45**2 - 0.05**2) - 0.013])
+    for name, value in (
+        ("com_W", com),
+        ("com_velocity_W", 2.0 * rising),
+        ("omega_f_W", 2.0 * rising / np.linalg.norm(rising)),  # above alpha_full
+        ("x_d_W", x_d),
+        ("lean_W", lean),
+        ("path_tangent_W", rising),
+        ("path_progress", [0.0]),
+        ("advances", [1.0]),
+        ("response", [0.0]),
+    ):
+        law.GetInputPort(name).FixValue(context, value)
+    psi_dot = law.GetOutputPort("psi_dot_law").Eval(context)[0]
+    if leaned:
+        t2 = rising @ rising  # the tangent law's ratio, within the bounds
+        assert psi_dot == pytest.approx(2.0 * t2 / (t2 + cfg.eps), rel=1e-12)
+    else:
+        assert psi_dot == 1.0
 
 
 def _sensing_rig():
