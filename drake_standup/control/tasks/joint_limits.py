@@ -28,13 +28,15 @@ class JointLimitBounds:
         linear_limits: tuple[np.ndarray, np.ndarray] | None = None,
         num_velocities: int | None = None,
         speed_limit_rad_per_s: np.ndarray | None = None,
-        speed_time_constant_s: float = 0.05,
+        speed_time_constant_s: float | None = None,
     ):
         """speed_limit_rad_per_s: each joint's speed limit (inf: none; None: none), held
-        by speed_bounds with speed_time_constant_s."""
+        by speed_bounds with speed_time_constant_s (required with a limit)."""
         self.v_indices = v_indices
         self._speed = None
         if speed_limit_rad_per_s is not None and np.isfinite(speed_limit_rad_per_s).any():
+            if speed_time_constant_s is None:
+                raise ValueError("a speed limit needs its speed_time_constant_s")
             self._speed = np.asarray(speed_limit_rad_per_s, dtype=float)
         self._speed_tau = speed_time_constant_s
         self._q, self._v = as_slice(q_indices), as_slice(v_indices)
