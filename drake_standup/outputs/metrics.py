@@ -54,6 +54,7 @@ def standup_metrics(
     height_tolerance_m: float = 0.01,
     unloaded_N: float = 5.0,
     hold_s: float = 0.2,
+    trunk_twisted: np.ndarray | None = None,
 ) -> dict:
     """Stand-up time, CoM tracking and whether the robot is standing at the end.
 
@@ -71,7 +72,8 @@ def standup_metrics(
     the robot stays standing for hold_s (None if never); standing_at_end: standing at
     the last sample. 5 N is the unloading level of issue 12's chatter count: 1.5 % of
     the robot's weight, above the 1-3 N a pad still feels while it lifts off a
-    compliant seat, far below the 50-170 N the thighs carry seated.
+    compliant seat, far below the 50-170 N the thighs carry seated. trunk_twisted (one
+    bool a sample, torso_twist): a sample whose trunk is twisted is not standing either.
     """
     t = signals["time_s"]
     error = np.linalg.norm(signals["com_W"] - signals["com_reference_W"], axis=1)
@@ -100,6 +102,8 @@ def standup_metrics(
         height = np.sqrt(np.maximum(height**2 - lean[:, 0] ** 2 - lean[:, 1] ** 2, 0.0))
         height = height + lean[:, 2]  # lower with the arms braced against a strong pull
     standing = (np.abs(signals["com_W"][:, 2] - height) <= height_tolerance_m) & unloaded
+    if trunk_twisted is not None:
+        standing &= ~trunk_twisted
     metrics["standing_at_end"] = bool(standing[-1])
     # Standing from sample i through t[i] + hold_s: no non-standing sample up to the
     # last sample within the hold, and the run lasts that long.
@@ -302,6 +306,37 @@ def limb_metrics(signals: dict[str, np.ndarray]) -> dict:
     return metrics
 
 
+# The trunk's joints out of the sagittal plane: the posture holds them where the robot sat.
+TWIST_JOINTS = ("torso_roll", "torso_yaw")
+
+
+def torso_twist(
+    signals: dict[str, np.ndarray], limits_rad: dict[str, tuple[float, float]]
+) -> tuple[dict, np.ndarray | None]:
+    """(metrics, twisted): peak_torso_twist_rad and torso_twist_at_end_rad, the largest
+    |q - q_0| of TWIST_JOINTS (q_0: the first sample, where the robot sits); twisted, one
+    bool a sample: a joint more than half-way from q_0 to its stop (limits_rad: name ->
+    (lower, upper)), a trunk no roboticist calls erect (issue 60: under a strong pull
+    the QP drove the torso's yaw and roll onto their stops while the CoM stood tall).
+    None where the model has none of the joints."""
+    names = [str(name) for name in signals["joint_names"]]
+    columns = [names.index(j) for j in TWIST_JOINTS if j in names and j in limits_rad]
+    if not columns or not len(signals["time_s"]):
+        return {"peak_torso_twist_rad": None, "torso_twist_at_end_rad": None}, None
+    q = signals["joint_positions_rad"][:, columns]
+    d = q - q[0]
+    lower = np.array([limits_rad[names[c]][0] for c in columns]) - q[0]
+    upper = np.array([limits_rad[names[c]][1] for c in columns]) - q[0]
+    to_stop = np.where(d >= 0.0, np.maximum(upper, 1e-9), np.minimum(lower, -1e-9))
+    twisted = np.any(d / to_stop > 0.5, axis=1)
+    deviation = np.abs(d).max(axis=1)
+    metrics = {
+        "peak_torso_twist_rad": float(deviation.max()),
+        "torso_twist_at_end_rad": float(deviation[-1]),
+    }
+    return metrics, twisted
+
+
 def sit_backs(state: np.ndarray) -> int:
     """How often the stand-up went back to state 1 once it had left it (a pull against
     it sat it back), from the state's samples."""
@@ -333,11 +368,21 @@ def run_metrics(
     metrics["robot_mass_kg"] = mass_kg
     metrics["simulated_mass_kg"] = simulated_mass_kg
     samples = len(signals["time_s"])
+    limits = {}
+    for name in TWIST_JOINTS:
+        if plant.HasJointNamed(name, instance):
+            joint = plant.GetJointByName(name, instance)
+            limits[name] = (joint.position_lower_limits()[0], joint.position_upper_limits()[0])
+    twist, twisted = torso_twist(signals, limits)
+    metrics.update(twist)
     if psi_final is not None:
         metrics.update(advancement_metrics(psi_final, signals["psi_dot"], entry_times_s))
         metrics.update(
             standup_metrics(
-                signals, metrics["state_entry_times_s"], standing_height_m=standing_height_m
+                signals,
+                metrics["state_entry_times_s"],
+                standing_height_m=standing_height_m,
+                trunk_twisted=twisted,
             )
         )
         metrics["qp_failures"] = int(signals["qp_failures"][-1]) if samples else 0

@@ -12,6 +12,7 @@ from drake_standup.outputs.metrics import (
     sit_backs,
     smoothness_metrics,
     standup_metrics,
+    torso_twist,
 )
 
 PADS = {
@@ -307,3 +308,57 @@ def test_sit_backs_count_the_returns_to_state_1():
     """State 1 again after 2 or 3 counts; staying in 1, and a step back from 3 to 2, do not."""
     assert sit_backs(np.array([1, 1, 2, 2, 1, 1, 2, 3, 2, 3, 1, 2, 3, 4])) == 2
     assert sit_backs(np.array([1, 1, 1])) == 0
+
+
+def _twisting(t, yaw_of_t, roll0=0.1):
+    """Joint signals: torso_roll sat at roll0 and stays; torso_yaw follows yaw_of_t(t)."""
+    q = np.zeros((len(t), 3))
+    q[:, 0] = roll0
+    q[:, 1] = yaw_of_t(t)
+    q[:, 2] = 0.3  # a knee, not judged
+    return {
+        "time_s": t,
+        "joint_names": np.array(["torso_roll", "torso_yaw", "l_knee"]),
+        "joint_positions_rad": q,
+    }
+
+
+LIMITS = {"torso_roll": (-0.5, 0.5), "torso_yaw": (-0.9, 0.6), "l_knee": (-2.0, 0.0)}
+
+
+def test_the_twist_is_judged_half_way_to_each_stop():
+    t = np.arange(0.0, 4.0, 0.5)
+    # The yaw sat at 0: its stops are 0.6 up and 0.9 down, half-way 0.3 and 0.45.
+    yaw = {0.0: 0.0, 0.5: 0.29, 1.0: 0.31, 1.5: -0.44, 2.0: -0.46, 2.5: 0.0, 3.0: 0.7, 3.5: 0.1}
+    m, twisted = torso_twist(_twisting(t, lambda t: np.array([yaw[x] for x in t])), LIMITS)
+    assert twisted.tolist() == [False, False, True, False, True, False, True, False]
+    assert m["peak_torso_twist_rad"] == pytest.approx(0.7)
+    assert m["torso_twist_at_end_rad"] == pytest.approx(0.1)
+    # The roll is judged from where it sat (0.1): 0.3 is 0.2 of its 0.4 to the stop.
+    sig = _twisting(t, lambda t: 0.0 * t)
+    sig["joint_positions_rad"][3:, 0] = 0.3
+    assert not torso_twist(sig, LIMITS)[1].any()
+    sig["joint_positions_rad"][3:, 0] = 0.31
+    assert torso_twist(sig, LIMITS)[1].tolist() == [False] * 3 + [True] * 5
+
+
+def test_a_model_without_the_trunk_joints_is_not_judged():
+    sig = _twisting(np.arange(0.0, 1.0, 0.5), lambda t: t)
+    sig["joint_names"] = np.array(["a", "b", "l_knee"])
+    m, twisted = torso_twist(sig, LIMITS)
+    assert twisted is None and m["peak_torso_twist_rad"] is None
+
+
+def test_a_twisted_trunk_is_not_standing():
+    sig = _signals(t_stand=7.0, t_thighs_off=6.5)
+    t = sig["time_s"]
+    assert standup_metrics(sig, ENTRIES, trunk_twisted=np.zeros(len(t), bool))[
+        "standup_time_s"
+    ] == pytest.approx(4.0, abs=DT)
+    # Twisted from 6.9 s to 8.0 s: standing begins at 8.0 s, 5.0 s after state 2.
+    twisted = (t >= 6.9) & (t < 8.0)
+    m = standup_metrics(sig, ENTRIES, trunk_twisted=twisted)
+    assert m["standup_time_s"] == pytest.approx(5.0, abs=DT)
+    assert m["standing_at_end"] is True
+    m = standup_metrics(sig, ENTRIES, trunk_twisted=t >= 9.0)
+    assert m["standing_at_end"] is False
