@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 
 # The QP solvers the controller can use (control/backends.py: make_backend).
 QP_SOLVERS = ("daqp", "osqp", "clarabel")
+# The axes the angular momentum's integral acts on (control/tasks/momentum.py).
+MOMENTUM_INTEGRAL_AXES = ("pitch", "all")
 # The libraries that can compute the controller's model (control/model.py).
 MODEL_LIBRARIES = ("drake", "pinocchio")
 
@@ -21,6 +23,12 @@ class ControllerConfig:
     com_damping_ratio: float = 1.0
     # Angular momentum: Ldot_ang* = -K_D L_ang - K_P int L_ang; K_P,ang = 1 ([authors-code]). 1/s^2.
     angular_momentum_kp_per_s2: float = 1.0
+    # ... about all three axes ("all": the authors'), or the heading's pitch axis only
+    # ("pitch"): the base orientation task already holds the pelvis' roll and yaw, and a
+    # second reference on them wound up in a strong pull's twist and then drove the trunk
+    # onto its stops with nobody pulling; "pitch" mends that on ideal senses but not under
+    # icub (docs/decisions/021-momentum-integral-axes.md).
+    angular_momentum_integral_axes: str = "all"
     # Angular momentum damping K_D,ang ([early-probe]: 5). 1/s.
     angular_momentum_kd_per_s: float = 5.0
     # Joint posture: qddot* = -K_P (q - q_ref) - K_D qdot ([early-probe]: 30). 1/s^2.

@@ -18,7 +18,7 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 
 from drake_standup.config.body import TONES
 from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig
-from drake_standup.config.controller import MODEL_LIBRARIES, QP_SOLVERS
+from drake_standup.config.controller import MODEL_LIBRARIES, MOMENTUM_INTEGRAL_AXES, QP_SOLVERS
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.hardware import HARDWARE
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
@@ -88,6 +88,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (SEAT_PADS, "phases.*.unload[*]"),
     (WHEN_HINDERED, "phases.*.when_hindered"),
     (QP_SOLVERS, "controller.qp_solver"),
+    (MOMENTUM_INTEGRAL_AXES, "controller.angular_momentum_integral_axes"),
     (MODEL_LIBRARIES, "controller.model_library"),
     (tuple(GetIntegrationSchemes()), "simulator.integration_scheme"),
     (("point", "hydroelastic", "hydroelastic_with_fallback"), "plant.contact_model"),

@@ -337,6 +337,16 @@ def torso_twist(
     return metrics, twisted
 
 
+def twist_limits_rad(plant, instance) -> dict[str, tuple[float, float]]:
+    """TWIST_JOINTS' position limits on the robot's model (those it has), rad."""
+    limits = {}
+    for name in TWIST_JOINTS:
+        if plant.HasJointNamed(name, instance):
+            joint = plant.GetJointByName(name, instance)
+            limits[name] = (joint.position_lower_limits()[0], joint.position_upper_limits()[0])
+    return limits
+
+
 def sit_backs(state: np.ndarray) -> int:
     """How often the stand-up went back to state 1 once it had left it (a pull against
     it sat it back), from the state's samples."""
@@ -368,12 +378,7 @@ def run_metrics(
     metrics["robot_mass_kg"] = mass_kg
     metrics["simulated_mass_kg"] = simulated_mass_kg
     samples = len(signals["time_s"])
-    limits = {}
-    for name in TWIST_JOINTS:
-        if plant.HasJointNamed(name, instance):
-            joint = plant.GetJointByName(name, instance)
-            limits[name] = (joint.position_lower_limits()[0], joint.position_upper_limits()[0])
-    twist, twisted = torso_twist(signals, limits)
+    twist, twisted = torso_twist(signals, twist_limits_rad(plant, instance))
     metrics.update(twist)
     if psi_final is not None:
         metrics.update(advancement_metrics(psi_final, signals["psi_dot"], entry_times_s))

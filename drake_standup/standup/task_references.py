@@ -231,6 +231,7 @@ class TaskReferenceGenerator:
         )
         stance, vertical_weight_scale = self._stance(state, now.path_progress)
         helped = F_hand_W is not None and response == ADVANCEMENT
+        q_reference, next_posture, base_yaw = self._posture(terms, state, carried.posture, psi_dot)
         momentum = self.momentum.target(
             terms,
             com_target,
@@ -240,8 +241,8 @@ class TaskReferenceGenerator:
             stance,
             height_integral=carried.height_integral,
             pull_W=F_hand_W[3:6] + F_hand_W[9:12] if helped else None,
+            heading_rad=base_yaw,
         )
-        q_reference, next_posture, base_yaw = self._posture(terms, state, carried.posture, psi_dot)
         return TaskReferences(
             standup_state=standup_state,
             state=state,

@@ -326,6 +326,39 @@ def test_the_momentum_law_is_the_papers_objective_component_by_component():
     np.testing.assert_allclose(out.next_momentum_integral, integral + 0.004 * terms.L_WCom[:3])
 
 
+def test_the_momentum_integral_about_the_pitch_axis_only_keeps_that_component():
+    """angular_momentum_integral_axes 'pitch': int L <- ((int L + T L) . a) a with a the
+    heading's pitch axis (-sin psi, cos psi, 0); its roll and yaw parts are dropped, so a
+    pitch-only integral acts as the authors' on a sagittal motion; 'all' keeps the sum."""
+    config = ControllerConfig(angular_momentum_integral_axes="pitch")
+    law = MomentumLaw(config, period_s=0.004, gravity_mps2=9.81)
+    terms = _terms_at([0.1, 0.0, 0.5], np.zeros(3), [0.3, -0.4, 0.5, 0, 0, 0], 33.0)
+    target, zero = np.array([0.1, 0.0, 0.5, 0, 0, 0, 0, 0, 0]), np.zeros(3)
+    integral = np.array([0.01, 0.02, -0.03])
+    summed = integral + 0.004 * terms.L_WCom[:3]
+    for heading in (0.0, math.pi, 0.3):
+        axis = np.array([-math.sin(heading), math.cos(heading), 0.0])
+        out = law.target(
+            terms,
+            target,
+            zero,
+            zero,
+            integral,
+            0.0,
+            height_integral=0.0,
+            pull_W=None,
+            heading_rad=heading,
+        )
+        np.testing.assert_allclose(out.next_momentum_integral, (summed @ axis) * axis, atol=1e-15)
+    sagittal = np.array([0.0, 0.05, 0.0])
+    out = law.target(terms, target, zero, zero, sagittal, 0.0, height_integral=0.0, pull_W=None)
+    authors = MomentumLaw(ControllerConfig(), 0.004, 9.81).target(
+        terms, target, zero, zero, sagittal, 0.0, height_integral=0.0, pull_W=None
+    )
+    np.testing.assert_array_equal(out.Ldot_star, authors.Ldot_star)  # this tick's, unchanged
+    assert ControllerConfig().angular_momentum_integral_axes == "all"
+
+
 def test_the_momentum_law_lets_through_only_the_pull_along_the_path():
     """Past the fade speed and at the reference (no lead), f_par = (f . u) u for a pull
     with a component along xd_dot, 0 for one against it; it adds to m xddot*, faded by the

@@ -4,6 +4,9 @@ contacts must give (Nava et al., IROS 2016: [nava2016]), L = [L_ang about the Co
     xddot* = xd_ddot - K_D (xdot - xd_dot) - K_P (x - x_d)
     Ldot*  = [-K_D,ang L_ang - K_P,ang int L_ang;  m xddot* + f_par  (+ m K_I int e_z)]
 
+(controller.angular_momentum_integral_axes "pitch": int L_ang about the heading's pitch
+axis only, the base orientation task holding the roll and yaw.)
+
 The hands' measured wrench acts on the robot in full (the task's b, and the QP's dynamics
 rows); Ldot* lets its helpful part f_par through (helpful_force), so the contacts cancel
 everything else of it. In the stance (the legs end the rise) an integral of the CoM height
@@ -132,11 +135,14 @@ class MomentumLaw:
         *,
         height_integral: float,
         pull_W: np.ndarray | None,
+        heading_rad: float = 0.0,
     ) -> MomentumTarget:
         """com_target = [x_d, xd_dot, xd_ddot] (9,); momentum_integral: int L_ang dt and
         height_integral: the stance's, before the tick; stance: how far the legs have taken
         over, 0-1 (0: no integral); pull_W: the hands' total force whose helpful part goes
-        through (None: none does)."""
+        through (None: none does); heading_rad: the yaw the robot faces (the base target's),
+        whose pitch axis keeps the integral where config.angular_momentum_integral_axes
+        is "pitch"."""
         config = self._config
         xddot_star = com_acceleration_reference(
             terms.p_WCom, terms.v_WCom, com_target, kp_per_s2, kd_per_s
@@ -169,9 +175,8 @@ class MomentumLaw:
             # the help carried the CoM onto straight, locked knees (measured).
             f_par *= 1.0 - stance
             Ldot_star[3:] += f_par
-        return MomentumTarget(
-            Ldot_star,
-            f_par,
-            next_height_integral,
-            momentum_integral + self._period_s * terms.L_WCom[:3],
-        )
+        next_momentum_integral = momentum_integral + self._period_s * terms.L_WCom[:3]
+        if config.angular_momentum_integral_axes == "pitch":
+            axis = np.array([-math.sin(heading_rad), math.cos(heading_rad), 0.0])
+            next_momentum_integral = (next_momentum_integral @ axis) * axis
+        return MomentumTarget(Ldot_star, f_par, next_height_integral, next_momentum_integral)
