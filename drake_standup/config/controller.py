@@ -161,6 +161,14 @@ class ControllerConfig:
     # near straight legs 1 cm of CoM height is 0.3 rad of knee.
     stance_from_progress: float = 0.7
     stance_vertical_weight_scale: float = 0.1
+    # In the stance (the stance factor, 0 -> 1 over the rise's end) the angular momentum's
+    # target asks the contacts for the moment that the trunk's roll and yaw posture needs
+    # (their posture acceleration through the centroidal momentum matrix): the momentum
+    # task, at 100 times the posture's weight, left the trunk's posture about 50 times
+    # weaker than its gain, and a standing trunk drifted (icub) or stayed twisted onto its
+    # stops after a strong pull. Through the rise the trunk stays free: held throughout,
+    # iCubDarmstadt01's thighs slapped at their release (docs/decisions/022-standing-trunk.md).
+    standing_trunk_attitude: bool = True
     # Integral gain on the CoM height error in the stance (standup/task_references.py). 1/s^3.
     stance_height_ki_per_s3: float = 100.0
     # The lean's first-order lag: the pull's moment, not its jitter, and about the CoM

@@ -8,7 +8,12 @@ import numpy as np
 from drake_standup.helper.work import HELPER_SPENT
 from drake_standup.outputs.estimation import estimation_metrics
 from drake_standup.outputs.signals import group_mean_normal_forces, group_normal_forces
-from drake_standup.robot.limbs import JOINT_GROUPS, joint_group, shoulder_tendon_margin_rad
+from drake_standup.robot.limbs import (
+    JOINT_GROUPS,
+    TRUNK_TWIST_JOINTS,
+    joint_group,
+    shoulder_tendon_margin_rad,
+)
 
 
 def seated_metrics(signals: dict[str, np.ndarray], weight_N: float, settle_s: float = 0.5) -> dict:
@@ -306,8 +311,7 @@ def limb_metrics(signals: dict[str, np.ndarray]) -> dict:
     return metrics
 
 
-# The trunk's joints out of the sagittal plane: the posture holds them where the robot sat.
-TWIST_JOINTS = ("torso_roll", "torso_yaw")
+TWIST_JOINTS = TRUNK_TWIST_JOINTS
 
 
 def torso_twist(

@@ -50,6 +50,10 @@ _TENDON_B_DEG = np.array(
     [404.0, 54.3, 46.0, 305.7, 215.7, 150.0, 54.3, 210.0, 431.0, 101.7, 109.0, 258.3, 71.7, 228.3]
 )
 SHOULDER_JOINTS = ("shoulder_pitch", "shoulder_roll", "shoulder_yaw")
+# The trunk's joints out of the sagittal plane: a symmetric stand-up holds them where the
+# robot sat (outputs/metrics.py judges their twist; standup/task_references.py holds them
+# standing).
+TRUNK_TWIST_JOINTS = ("torso_roll", "torso_yaw")
 
 
 def joint_group(name: str) -> str:

@@ -34,12 +34,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import partial
 
+import numpy as np
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from drake_standup.config import Scenario
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
+from drake_standup.robot.limbs import TRUNK_TWIST_JOINTS
 from drake_standup.standup.advancement import TrajectoryAdvancement, for_robot
 from drake_standup.standup.com_path import CoMReferenceGenerator
 from drake_standup.standup.contact_schedule import ContactSchedule
@@ -176,6 +178,8 @@ def _standup_systems(scenario: Scenario, station: Station, plan: StandupPlan) ->
                 scenario.compliance,
                 standing_need=partial(standing_lean, support=station.standing),
                 usage_limit=scenario.standup.standing_pull_usage_limit,
+                v_joints=np.asarray(joints.v_indices),
+                trunk=np.array([i for i, n in enumerate(joints.names) if n in TRUNK_TWIST_JOINTS]),
             ),
             WholeBodyController(
                 plant,

@@ -41,7 +41,9 @@ from drake_standup.config.phases import PhaseTable
 from drake_standup.control.smooth import psi_clock_blend, smoothstep
 from drake_standup.control.targets import StateReferences, TaskReferences, joint_values
 from drake_standup.control.tasks import BaseTarget, MomentumLaw, next_posture_reference
+from drake_standup.control.tasks.posture import posture_acceleration_reference
 from drake_standup.control.terms import RobotTerms
+from drake_standup.robot.spatial import skew
 from drake_standup.standup.com_path import CoMTarget
 
 # The response codes (the index in config.RESPONSES) the controller's systems read.
@@ -146,13 +148,18 @@ class TaskReferenceGenerator:
         *,
         standing_need: Callable | None = None,
         usage_limit: float = 1.0,
+        v_joints: np.ndarray | None = None,
+        trunk: np.ndarray | None = None,
     ):
         """q_joints: the actuated joints' entries of q, in the phase references' order;
         gravity_mps2: g, the plant's. The robot's weight is that of the model the terms
         are computed with (terms.mass_kg g: the controller's estimate once it has
         weighed the robot), for the lean against the pull and the height integral's
         bound. compliance, standing_need, usage_limit: the CoM target's (com_path.py:
-        CoMTarget)."""
+        CoMTarget). v_joints: the actuated joints' entries of v; trunk: the trunk's
+        twist joints' places among the actuated ones (robot/limbs.py: TRUNK_TWIST_JOINTS),
+        held standing by the contacts (ControllerConfig.standing_trunk_attitude; None:
+        not)."""
         self._config = config
         self.phases = phases
         self._q_joints = q_joints
@@ -164,6 +171,26 @@ class TaskReferenceGenerator:
         )
         self.momentum = MomentumLaw(config, period_s, gravity_mps2)
         self.base_target = BaseTarget()
+        self._trunk = None
+        if config.standing_trunk_attitude and trunk is not None and len(trunk):
+            self._trunk = (np.asarray(trunk), np.asarray(v_joints)[np.asarray(trunk)])
+        self._posture_kd = 2.0 * config.posture_damping_ratio * math.sqrt(config.posture_kp_per_s2)
+
+    def _trunk_Ldot(
+        self, terms: RobotTerms, q_reference: np.ndarray, stance: float
+    ) -> np.ndarray | None:
+        """stance A_G,ang[trunk] qddot*_trunk: the angular momentum rate that the trunk's
+        posture acceleration (posture_acceleration_reference toward q_reference) makes,
+        asked of the contacts in the stance (None: not in the stance, or no trunk)."""
+        if self._trunk is None or stance <= 0.0:
+            return None
+        places, v = self._trunk
+        q = terms.q[self._q_joints][places]
+        qddot = posture_acceleration_reference(
+            q, terms.v[v], q_reference[places], self._config.posture_kp_per_s2, self._posture_kd
+        )
+        A_ang = terms.M[:3, v] - skew(terms.p_BoCom) @ terms.M[3:6, v]
+        return stance * (A_ang @ qddot)
 
     def _stance(self, state: StateReferences, path_progress: float) -> tuple[float, float]:
         """(how far the legs have taken over the end of the rise, 0-1; the momentum
@@ -242,6 +269,7 @@ class TaskReferenceGenerator:
             height_integral=carried.height_integral,
             pull_W=F_hand_W[3:6] + F_hand_W[9:12] if helped else None,
             heading_rad=base_yaw,
+            trunk_Ldot=self._trunk_Ldot(terms, q_reference, stance),
         )
         return TaskReferences(
             standup_state=standup_state,

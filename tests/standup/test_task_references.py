@@ -453,3 +453,53 @@ def test_the_psi_clock_blend_is_a_first_order_step_never_slower_than_time():
     assert psi_clock_blend(0.01, 0.2, 2.5) == pytest.approx(0.125)
     assert psi_clock_blend(0.01, 0.2, 0.3) == pytest.approx(0.05)
     assert psi_clock_blend(0.3, 0.2, 1.0) == 1.0
+
+
+def test_standing_the_contacts_are_asked_the_trunks_posture_moment(rig):
+    """In the stance (state 4 at the segment's end: stance 1) Ldot_ang* gains
+    A_G,ang[trunk] qddot*_trunk, qddot* = -K_P (q - q_ref) - K_D qdot (the first tick: q_ref
+    = q); each column of A_G,ang is Drake's angular momentum about the CoM with a unit
+    rate of that joint alone. Before the stance (progress 0.5) and without the trunk it
+    adds nothing."""
+    plant, context, instance, joints = rig["plant"], rig["context"], rig["instance"], rig["joints"]
+    names = list(joints.names)
+    trunk = np.array([names.index("torso_roll"), names.index("torso_yaw")])
+    v_joints = np.asarray(joints.v_indices)
+    held = TaskReferenceGenerator(
+        CONFIG,
+        rig["phases"],
+        as_slice(joints.q_indices),
+        T,
+        rig["g"],
+        v_joints=v_joints,
+        trunk=trunk,
+    )
+    plain = rig["generator"]
+    try:
+        rig["generator"] = held
+        standing, _ = _calc(rig, 4, progress=1.0)
+        rising, _ = _calc(rig, 4, progress=0.5)
+    finally:
+        rig["generator"] = plain
+    alone_standing, _ = _calc(rig, 4, progress=1.0)
+    alone_rising, _ = _calc(rig, 4, progress=0.5)
+    np.testing.assert_array_equal(rising.Ldot_star, alone_rising.Ldot_star)
+    p, _, _, _ = _drake_com(rig)
+    v = rig["x"][plant.num_positions(instance) :]
+    scratch = plant.CreateDefaultContext()
+    plant.SetPositions(scratch, instance, plant.GetPositions(context, instance))
+    columns = []
+    for j in v_joints[trunk]:
+        unit = np.zeros(plant.num_velocities(instance))
+        unit[j] = 1.0
+        plant.SetVelocities(scratch, instance, unit)
+        columns.append(
+            plant.CalcSpatialMomentumInWorldAboutPoint(scratch, [instance], p).rotational()
+        )
+    kd = 2.0 * CONFIG.posture_damping_ratio * math.sqrt(CONFIG.posture_kp_per_s2)
+    expected = np.array(columns).T @ (-kd * v[v_joints[trunk]])
+    assert np.abs(expected).max() > 1e-3  # the rig's trunk moves
+    np.testing.assert_allclose(
+        standing.Ldot_star[:3] - alone_standing.Ldot_star[:3], expected, rtol=1e-9, atol=1e-12
+    )
+    np.testing.assert_array_equal(standing.Ldot_star[3:], alone_standing.Ldot_star[3:])

@@ -136,13 +136,15 @@ class MomentumLaw:
         height_integral: float,
         pull_W: np.ndarray | None,
         heading_rad: float = 0.0,
+        trunk_Ldot: np.ndarray | None = None,
     ) -> MomentumTarget:
         """com_target = [x_d, xd_dot, xd_ddot] (9,); momentum_integral: int L_ang dt and
         height_integral: the stance's, before the tick; stance: how far the legs have taken
         over, 0-1 (0: no integral); pull_W: the hands' total force whose helpful part goes
         through (None: none does); heading_rad: the yaw the robot faces (the base target's),
         whose pitch axis keeps the integral where config.angular_momentum_integral_axes
-        is "pitch"."""
+        is "pitch"; trunk_Ldot: an angular momentum rate added to Ldot_ang* (the trunk's
+        posture standing: task_references.py), N m (None: none)."""
         config = self._config
         xddot_star = com_acceleration_reference(
             terms.p_WCom, terms.v_WCom, com_target, kp_per_s2, kd_per_s
@@ -150,6 +152,8 @@ class MomentumLaw:
         Ldot_star = np.empty(6)
         Ldot_star[:3] = -config.angular_momentum_kd_per_s * terms.L_WCom[:3]
         Ldot_star[:3] -= config.angular_momentum_kp_per_s2 * momentum_integral
+        if trunk_Ldot is not None:
+            Ldot_star[:3] += trunk_Ldot
         Ldot_star[3:] = terms.mass_kg * xddot_star
         next_height_integral = 0.0
         if stance > 0.0:
