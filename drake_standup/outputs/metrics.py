@@ -12,6 +12,7 @@ from drake_standup.robot.limbs import (
     JOINT_GROUPS,
     TRUNK_TWIST_JOINTS,
     joint_group,
+    joint_limits_rad,
     shoulder_tendon_margin_rad,
 )
 
@@ -311,20 +312,17 @@ def limb_metrics(signals: dict[str, np.ndarray]) -> dict:
     return metrics
 
 
-TWIST_JOINTS = TRUNK_TWIST_JOINTS
-
-
 def torso_twist(
     signals: dict[str, np.ndarray], limits_rad: dict[str, tuple[float, float]]
 ) -> tuple[dict, np.ndarray | None]:
     """(metrics, twisted): peak_torso_twist_rad and torso_twist_at_end_rad, the largest
-    |q - q_0| of TWIST_JOINTS (q_0: the first sample, where the robot sits); twisted, one
+    |q - q_0| of TRUNK_TWIST_JOINTS (q_0: the first sample, where the robot sits); twisted, one
     bool a sample: a joint more than half-way from q_0 to its stop (limits_rad: name ->
     (lower, upper)), a trunk no roboticist calls erect (issue 60: under a strong pull
     the QP drove the torso's yaw and roll onto their stops while the CoM stood tall).
     None where the model has none of the joints."""
     names = [str(name) for name in signals["joint_names"]]
-    columns = [names.index(j) for j in TWIST_JOINTS if j in names and j in limits_rad]
+    columns = [names.index(j) for j in TRUNK_TWIST_JOINTS if j in names and j in limits_rad]
     if not columns or not len(signals["time_s"]):
         return {"peak_torso_twist_rad": None, "torso_twist_at_end_rad": None}, None
     q = signals["joint_positions_rad"][:, columns]
@@ -339,16 +337,6 @@ def torso_twist(
         "torso_twist_at_end_rad": float(deviation[-1]),
     }
     return metrics, twisted
-
-
-def twist_limits_rad(plant, instance) -> dict[str, tuple[float, float]]:
-    """TWIST_JOINTS' position limits on the robot's model (those it has), rad."""
-    limits = {}
-    for name in TWIST_JOINTS:
-        if plant.HasJointNamed(name, instance):
-            joint = plant.GetJointByName(name, instance)
-            limits[name] = (joint.position_lower_limits()[0], joint.position_upper_limits()[0])
-    return limits
 
 
 def sit_backs(state: np.ndarray) -> int:
@@ -382,7 +370,7 @@ def run_metrics(
     metrics["robot_mass_kg"] = mass_kg
     metrics["simulated_mass_kg"] = simulated_mass_kg
     samples = len(signals["time_s"])
-    twist, twisted = torso_twist(signals, twist_limits_rad(plant, instance))
+    twist, twisted = torso_twist(signals, joint_limits_rad(plant, instance, TRUNK_TWIST_JOINTS))
     metrics.update(twist)
     if psi_final is not None:
         metrics.update(advancement_metrics(psi_final, signals["psi_dot"], entry_times_s))

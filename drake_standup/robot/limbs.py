@@ -56,6 +56,16 @@ SHOULDER_JOINTS = ("shoulder_pitch", "shoulder_roll", "shoulder_yaw")
 TRUNK_TWIST_JOINTS = ("torso_roll", "torso_yaw")
 
 
+def joint_limits_rad(plant, instance, names) -> dict[str, tuple[float, float]]:
+    """(lower, upper) position limits of each named joint the model has, rad."""
+    limits = {}
+    for name in names:
+        if plant.HasJointNamed(name, instance):
+            joint = plant.GetJointByName(name, instance)
+            limits[name] = (joint.position_lower_limits()[0], joint.position_upper_limits()[0])
+    return limits
+
+
 def joint_group(name: str) -> str:
     """The limb (a JOINT_GROUPS key) of an actuated joint, by its name."""
     for group, parts in JOINT_GROUPS.items():

@@ -19,6 +19,7 @@ from drake_standup.config.phases import (
     resolve_com_x,
     resolve_postures,
 )
+from drake_standup.robot.limbs import joint_limits_rad
 from drake_standup.world.scene import Scene
 from drake_standup.world.seating import JOINT_MARGIN_RAD, LEG_JOINTS
 from drake_standup.world.sensing import FeetReach
@@ -64,15 +65,9 @@ def seated_shift(scene: Scene) -> tuple[dict[str, float], dict[str, tuple[float,
     """(how far the robot's seated leg joints (seating.LEG_JOINTS, both sides) are from
     the shipped seated pose's, and those joints' limits), rad, by joint name."""
     plant, instance = scene.plant, scene.robot.model_instance
-    shift, limits = {}, {}
-    for side in "lr":
-        for joint in LEG_JOINTS:
-            name = f"{side}_{joint}"
-            if name not in scene.seated.joints_rad or not plant.HasJointNamed(name, instance):
-                continue
-            shift[name] = scene.seated.joints_rad[name] - SEATED_JOINTS[name]
-            j = plant.GetJointByName(name, instance)
-            limits[name] = (j.position_lower_limits()[0], j.position_upper_limits()[0])
+    names = [f"{side}_{joint}" for side in "lr" for joint in LEG_JOINTS]
+    limits = joint_limits_rad(plant, instance, [n for n in names if n in scene.seated.joints_rad])
+    shift = {name: scene.seated.joints_rad[name] - SEATED_JOINTS[name] for name in limits}
     return shift, limits
 
 
