@@ -34,6 +34,7 @@ COMMANDS = {
     ),
     "convergence": ("drake_standup.studies.convergence", "the plant-step convergence study"),
     "scenarios": ("drake_standup.cli", "list the shipped scenarios and sweeps"),
+    "list": ("drake_standup.cli", "list the plug-ins by kind: laws and helpers, yours too"),
 }
 
 
@@ -59,6 +60,8 @@ def main(argv: list[str] | None = None) -> int:
         return run_main(["--live", *rest], prog)
     if name == "scenarios":
         return scenarios_main(rest, prog)
+    if name == "list":
+        return list_main(rest, prog)
     return importlib.import_module(COMMANDS[name][0]).main(rest, prog=prog)
 
 
@@ -187,6 +190,28 @@ def scenarios_main(argv: list[str] | None = None, prog: str = "drake-standup sce
         print(f"{folder} ({data_root() / folder}; drake-standup {command} NAME):")
         for name, path in shipped(folder).items():
             print(f"  {name:<12} {description(path)}")
+    return 0
+
+
+# --- list --------------------------------------------------------------------------------
+
+
+def list_main(argv: list[str] | None = None, prog: str = "drake-standup list") -> int:
+    OneLineErrorParser(
+        prog=prog,
+        description="List the plug-ins each scenario key can name: the shipped ones and "
+        "those installed packages register by entry point (docs/extending.md).",
+        epilog="example:\n  drake-standup list\n  drake-standup run --set "
+        "advancement.law=interaction",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    ).parse_args(argv)
+    from drake_standup.config.plugins import ENTRY_POINT_GROUP, KINDS, registered
+
+    for kind, key in KINDS.items():
+        group = ENTRY_POINT_GROUP.format(kind=kind)
+        print(f"{kind} ({key}: a name below, or module:attribute; entry points: {group}):")
+        for name, plugin in registered(kind).items():
+            print(f"  {name:<12} {plugin.description} [{plugin.origin}]")
     return 0
 
 

@@ -67,14 +67,12 @@ PLANT_STEP = Range(
 # patterns separated by spaces, '*' standing for any part of a name and '[*]' for any list
 # index. Checked in this order (tests/config/test_config.py: every pattern names a key).
 RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
-    (("scripted", "reactive", "body"), "human.mode"),
     (TONES, "human.body.tone"),
     # An adult the anthropometric table scales to (issue 32). m, kg.
     (Range(low=1.5, high=1.95), "human.body.height_m"),
     (Range(low=45.0, high=110.0), "human.body.mass_kg"),
     (("left", "right"), "human.pulls[*].hand"),
     (("velocity", "path"), "human.reactive.guide"),
-    (("tangent", "interaction"), "advancement.law"),
     (REFLECTED_INERTIA, "robot.reflected_inertia"),
     (HARDWARE, "robot.hardware"),
     # The robot's own rate: 25-1000 Hz (YARP ran the authors' at 100 Hz). Hz.
@@ -240,6 +238,7 @@ def validate(scenario: Scenario) -> Scenario:
     _check_names(scenario, data, check_robot_model(scenario.robot.model))
     if scenario.chair.file:
         check_chair_file(scenario.chair.file)
+    _check_plugins(scenario)
     if scenario.controller.model_library == "pinocchio":
         import importlib.util
 
@@ -249,6 +248,15 @@ def validate(scenario: Scenario) -> Scenario:
                 "(pip install 'drake_standup[pinocchio]'); accepted: drake"
             )
     return scenario
+
+
+def _check_plugins(scenario: Scenario) -> None:
+    """advancement.law and human.mode name plug-ins that import and fit their interface
+    (drake_standup/plugins: a registered name, module:attribute or an entry point)."""
+    from drake_standup.config.plugins import resolve
+
+    resolve("laws", scenario.advancement.law)
+    resolve("helpers", scenario.human.mode)
 
 
 def _check_rules(data: dict) -> None:

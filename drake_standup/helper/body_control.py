@@ -403,3 +403,18 @@ def make_body_helper(
     diagram = builder.Build()
     diagram.set_name("helper_body")
     return diagram
+
+
+def body_helper(
+    plant: MultibodyPlant,
+    robot: Robot,
+    config: HumanConfig,
+    person: HelperBody,
+    intent: LeafSystem | None = None,
+) -> Diagram:
+    """A person's body kneeling in front of the robot, pulling with human.reactive's intent
+    (make_body_helper)."""
+    return make_body_helper(plant, robot, config, person, intent)
+
+
+body_helper.adds_body = True  # the scene puts the person's body into the plant (world/scene.py)

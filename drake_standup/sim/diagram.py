@@ -17,9 +17,9 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort, Syste
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
 
 from drake_standup.config import RESPONSES, Scenario, validate
+from drake_standup.config.plugins import resolve
 from drake_standup.control.controller import WholeBodyController
-from drake_standup.helper.body_control import make_body_helper
-from drake_standup.helper.hands import HumanWrenchSource
+from drake_standup.helper.plugin import check_helper_ports
 from drake_standup.helper.work import HelperWork
 from drake_standup.robot.icub import actuated_joints
 from drake_standup.senses.wiring import add_muscles, add_senses, joint_damping
@@ -141,16 +141,7 @@ def _add_station_and_human(
     """The station, the human pulling at its hands and what the helper spends, wired;
     returns the station's and the human's systems and their outputs to export by name."""
     world = builder.AddNamedSystem("station", station.diagram)
-    helper = station.scene.helper
-    if helper is not None:  # the person's body; the live page's sliders set their intent
-        intent = make_human(station.plant, station.robot, scenario.human) if make_human else None
-        human = builder.AddNamedSystem(
-            "human", make_body_helper(station.plant, station.robot, scenario.human, helper, intent)
-        )
-    else:
-        human = builder.AddNamedSystem(
-            "human", (make_human or HumanWrenchSource)(station.plant, station.robot, scenario.human)
-        )
+    human = builder.AddNamedSystem("human", _make_helper(station, scenario, make_human))
     builder.Connect(world.GetOutputPort("robot_state"), human.GetInputPort("robot_state"))
     builder.Connect(
         human.GetOutputPort("spatial_forces"), world.GetInputPort("hand_spatial_forces")
@@ -179,6 +170,20 @@ def _add_station_and_human(
     if station.diagram.HasOutputPort("push_force_W"):
         outputs["push_force_W"] = world.GetOutputPort("push_force_W")
     return world, human, outputs
+
+
+def _make_helper(station: Station, scenario: Scenario, make_human: Callable | None) -> System:
+    """The helper human.mode names (drake_standup/plugins), or make_human's (the live page)."""
+    spec = scenario.human.mode
+    factory = resolve("helpers", spec).obj
+    plant, robot = station.plant, station.robot
+    if getattr(factory, "adds_body", False):  # the person's body; the page's sliders: intent
+        intent = make_human(plant, robot, scenario.human) if make_human else None
+        human = factory(plant, robot, scenario.human, station.scene.helper, intent)
+    else:
+        human = (make_human or factory)(plant, robot, scenario.human)
+    check_helper_ports(human, spec)
+    return human
 
 
 def _add_standup_controller(
@@ -240,11 +245,13 @@ def _add_law_from_truth(
     law = builder.AddNamedSystem(
         "advancement_from_truth", AdvancementLaw(for_robot(scenario.advancement, mass))
     )
-    for name in ("com_W", "com_velocity_W", "omega_f_W"):
+    for name in ("com_W", "com_velocity_W", "omega_f_W", "hand_wrenches_W"):
         builder.Connect(world.GetOutputPort(name), law.GetInputPort(name))
-    for name in ("x_d_W", "lean_W", "path_tangent_W", "path_progress", "advances"):
+    for name in ("x_d_W", "lean_W", "path_tangent_W", "path_progress", "advances", "psi"):
         builder.Connect(brain.GetOutputPort(name), law.GetInputPort(name))
     builder.Connect(outputs["response"], law.GetInputPort("response"))
+    builder.Connect(brain.GetOutputPort("psi_dot"), law.GetInputPort("psi_dot"))
+    builder.Connect(brain.GetOutputPort("standup_state"), law.GetInputPort("standup_state"))
     return {
         "psi_dot_law": brain.GetOutputPort("psi_dot_law"),
         "psi_dot_law_from_truth": law.GetOutputPort("psi_dot_law"),

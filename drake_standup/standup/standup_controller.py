@@ -73,6 +73,8 @@ _WIRES = [
     ("advancement", "path_tangent_W", "com_reference", "path_tangent_W"),
     ("advancement", "path_progress", "com_reference", "path_progress"),
     ("advancement", "advances", "state_machine", "advances"),
+    ("advancement", "hand_wrenches_W", "", "hand_wrenches_W"),
+    ("advancement", "standup_state", "state_machine", "standup_state"),
     ("com_reference", "psi", "advancement", "psi"),
     ("com_reference", "psi_dot", "advancement", "psi_dot"),
     ("com_reference", "psi_ddot", "advancement", "psi_ddot"),

@@ -181,7 +181,7 @@ def add_scene(
         RigidTransform(scenario.chair.xyz_m),
     )
     helper = alone = None
-    if scenario.human.mode == "body":  # the person holds the hands where the robot sits
+    if _adds_body(scenario.human.mode):  # the person holds the hands where the robot sits
         alone = _scene_alone(scenario)
         helper = add_helper_body(plant, scenario.human.body, seated_hands_W(alone))
     plant.Finalize()
@@ -272,3 +272,10 @@ def check_com_heights(scene: Scene, scenario: Scenario) -> None:
                 f"and <= {top} (m: {model}'s CoM standing straight, {straight:.3f}, "
                 f"+ {COM_HEIGHT_MARGIN_M})"
             )
+
+
+def _adds_body(mode: str) -> bool:
+    """The helper human.mode names puts a person's body into the plant (plugins: adds_body)."""
+    from drake_standup.config.plugins import resolve
+
+    return bool(getattr(resolve("helpers", mode).obj, "adds_body", False))

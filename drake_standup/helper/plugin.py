@@ -1,0 +1,134 @@
+"""A helper as a plug-in (human.mode names it: drake_standup/plugins).
+
+A helper is a factory helper(plant, robot, config) -> System: plant the MultibodyPlant, robot
+its iCub (robot/icub.py Robot: robot.frame(plant, 'l_hand')), config the scenario's human:
+section. The system has HumanWrenchSource's ports (helper/hands.py):
+
+    input  robot_state       [q; v] of the robot's model instance
+    output hand_wrenches_W   (12) [torque_l, force_l, torque_r, force_r] on the robot's hands,
+                             at the hand frames' origins, world frame, N m and N
+    output spatial_forces    the same as ExternallyAppliedSpatialForce for the plant
+
+HandWrenchHelper writes the ports: subclass it and give hand_wrenches(time_s, robot_state).
+A factory marked adds_body = True also gets the person's body the scene adds to the plant
+and the live page's intent (the shipped `body`, helper/body_control.py).
+"""
+
+from __future__ import annotations
+
+import inspect
+from typing import Any
+
+import numpy as np
+from pydrake.common.value import Value
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
+from pydrake.systems.framework import BasicVector, Context, LeafSystem, System
+
+from drake_standup.config import HumanConfig
+from drake_standup.config.plugins import PluginError
+from drake_standup.helper.hands import hand_forces
+from drake_standup.ports.caching import declare_cached
+from drake_standup.robot.icub import Robot
+
+PORTS = {"input": ("robot_state",), "output": ("hand_wrenches_W", "spatial_forces")}
+
+
+class HandWrenchHelper(LeafSystem):
+    """The ports of the module docstring around hand_wrenches(time_s, robot_state), which a
+    subclass gives: (12,) finite, or (2, 6) rows [torque, force] per hand."""
+
+    def __init__(self, plant: MultibodyPlant, robot: Robot, config: HumanConfig):
+        super().__init__()
+        self.plant, self.robot, self.config = plant, robot, config
+        self._applied = hand_forces(plant, robot)
+        nx = plant.num_multibody_states(robot.model_instance)
+        self._state = self.DeclareVectorInputPort("robot_state", nx)
+        prereq = {self.time_ticket(), self._state.ticket()}
+        self._cache = declare_cached(self, "hand wrenches", self._evaluate, prereq)
+        prereq = {self._cache.ticket()}
+        self.DeclareVectorOutputPort(
+            "hand_wrenches_W", 12, self._CalcWrenches, prerequisites_of_calc=prereq
+        )
+        self.DeclareAbstractOutputPort(
+            "spatial_forces",
+            lambda: Value[list[ExternallyAppliedSpatialForce]]([]),
+            self._CalcSpatialForces,
+            prerequisites_of_calc=prereq,
+        )
+
+    def hand_wrenches(self, time_s: float, robot_state: np.ndarray) -> np.ndarray:
+        """The wrenches on the hands now (module docstring); a subclass gives them."""
+        raise NotImplementedError("a HandWrenchHelper gives hand_wrenches(time_s, robot_state)")
+
+    def _evaluate(self, context: Context) -> np.ndarray:
+        t = context.get_time()
+        value = self.hand_wrenches(t, self._state.Eval(context))
+        wrenches = np.asarray(value, dtype=float)
+        if wrenches.size != 12 or wrenches.shape not in ((12,), (2, 6)):
+            raise PluginError(
+                f"human.mode: {type(self).__name__}.hand_wrenches gave shape {wrenches.shape} "
+                f"at t = {t:.3f} s; accepted: (12,) or (2, 6)"
+            )
+        if not np.all(np.isfinite(wrenches)):
+            raise PluginError(
+                f"human.mode: {type(self).__name__}.hand_wrenches gave a non-finite value at "
+                f"t = {t:.3f} s; accepted: finite N m and N"
+            )
+        return wrenches.reshape(12)
+
+    def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
+        output.SetFromVector(self._cache.Eval(context))
+
+    def _CalcSpatialForces(self, context: Context, output) -> None:
+        output.set_value(wrench_forces(self._applied, self._cache.Eval(context)))
+
+
+def wrench_forces(
+    applied: list[ExternallyAppliedSpatialForce], hand_wrenches_W: np.ndarray
+) -> list[ExternallyAppliedSpatialForce]:
+    """applied (hands.hand_forces) set to hand_wrenches_W's torques and forces, the hands
+    with a nonzero wrench only."""
+    pulled = []
+    for force, w in zip(applied, (hand_wrenches_W[:6], hand_wrenches_W[6:])):
+        if np.count_nonzero(w):
+            force.F_Bq_W = SpatialForce(w[:3], w[3:])
+            pulled.append(force)
+    return pulled
+
+
+def check_helper(obj: Any) -> str | None:
+    """What is wrong with obj as a helper factory (None: nothing)."""
+    if not callable(obj):
+        return f"is a {type(obj).__name__}, not callable; accepted: helper(plant, robot, config)"
+    arguments = (None,) * (5 if getattr(obj, "adds_body", False) else 3)
+    try:
+        inspect.signature(obj).bind(*arguments)
+    except TypeError:
+        return f"cannot be called as helper(plant, robot, config){_signature(obj)}"
+    except ValueError:
+        return None
+    return None
+
+
+def _signature(obj: Any) -> str:
+    try:
+        return f": its signature is {inspect.signature(obj)}"
+    except (TypeError, ValueError):
+        return ""
+
+
+def check_helper_ports(system: System, spec: str) -> None:
+    """A PluginError if the helper spec built lacks a port the diagram wires."""
+    if not isinstance(system, System):
+        raise PluginError(
+            f"human.mode: '{spec}' built a {type(system).__name__}; accepted: a Drake System "
+            "with the ports robot_state (in), hand_wrenches_W and spatial_forces (out)"
+        )
+    missing = [f"{name} (in)" for name in PORTS["input"] if not system.HasInputPort(name)]
+    missing += [f"{name} (out)" for name in PORTS["output"] if not system.HasOutputPort(name)]
+    if missing:
+        raise PluginError(
+            f"human.mode: '{spec}' built a system without the port(s) {', '.join(missing)}; "
+            "accepted: the ports of drake_standup.helper.plugin.HandWrenchHelper"
+        )

@@ -1,0 +1,212 @@
+"""The plug-in registry (config/plugins.py), the law's interface (standup/laws.py) and the
+helper's (helper/plugin.py): names resolved three ways, bad plug-ins as one error line with
+exit code 2, and a law outside the package equal to the same law inside it."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drake_standup.config import SCENARIO_DIR, AdvancementConfig, load_scenario
+from drake_standup.config.arguments import parse_set
+from drake_standup.config.plugins import PluginError, register, registered, resolve
+from drake_standup.standup.laws import (
+    LawInputs,
+    checked_rate,
+    interaction_law,
+    psi_dot_law,
+    tangent_law,
+)
+
+REPO = Path(__file__).resolve().parents[2]
+CONFIG = AdvancementConfig(alpha_full_mps2=0.6)
+
+
+def test_the_shipped_names_resolve_to_the_shipped_objects():
+    assert resolve("laws", "tangent").obj is tangent_law
+    assert resolve("laws", "interaction").obj is interaction_law
+    helpers = registered("helpers")
+    assert {"scripted", "reactive", "body"} <= set(helpers)
+    assert helpers["body"].obj.adds_body
+
+
+def test_module_attribute_resolves_a_law_outside_the_package():
+    import lab_laws
+
+    assert resolve("laws", "lab_laws:constant").obj is lab_laws.constant
+
+
+def test_a_registered_name_resolves_and_a_taken_one_is_refused():
+    def mine(inputs):
+        return 1.0
+
+    register("laws", "test_mine", mine)
+    assert resolve("laws", "test_mine").obj is mine
+    with pytest.raises(ValueError, match="registered already"):
+        register("laws", "test_mine", lambda inputs: 1.0)
+
+
+def test_an_entry_point_resolves(monkeypatch):
+    """An installed distribution's entry point, by its name (importlib.metadata stubbed)."""
+    point = types.SimpleNamespace(
+        name="from_ep", value="lab_laws:constant", dist=types.SimpleNamespace(name="labdist")
+    )
+    monkeypatch.setattr(
+        "importlib.metadata.entry_points",
+        lambda group: [point] if group == "drake_standup.laws" else [],
+    )
+    found = resolve("laws", "from_ep")
+    assert found.obj.__name__ == "constant" and "labdist" in found.origin
+    assert "from_ep" in registered("laws")
+
+
+@pytest.mark.parametrize(
+    ("spec", "says"),
+    [
+        ("no_such_law", "is not a known name; accepted: tangent | interaction"),
+        ("no_such_module_xyz:law", "module 'no_such_module_xyz' does not import"),
+        ("lab_laws:missing", "'lab_laws' has no attribute 'missing'"),
+        ("lab_laws:two_arguments", "has the signature (inputs, other); accepted: one argument"),
+        ("lab_laws:NOT_CALLABLE", "is a float, not callable"),
+        ("lab_laws", "is not a known name"),
+    ],
+)
+def test_a_bad_law_is_one_line_naming_the_key(spec, says):
+    with pytest.raises(PluginError) as err:
+        resolve("laws", spec)
+    text = str(err.value)
+    assert text.startswith("advancement.law: ") and says in text and "\n" not in text
+
+
+def test_a_bad_helper_is_one_line_naming_the_key():
+    with pytest.raises(PluginError, match=r"^human.mode: 'lab_laws:two_arguments' cannot be"):
+        resolve("helpers", "lab_laws:two_arguments")
+
+
+@pytest.mark.parametrize(
+    ("value", "says"),
+    [
+        (math.nan, "returned nan"),
+        (math.inf, "returned inf"),
+        (-0.5, "returned -0.5"),
+        ((1.0, 2.0), "returned shape (2,)"),
+        (np.ones((1, 1)), "returned shape (1, 1)"),
+        ("1.0", "returned a string"),
+        (None, "returned None"),
+    ],
+)
+def test_a_rate_that_is_not_one_finite_number_is_refused(value, says):
+    with pytest.raises(PluginError) as err:
+        checked_rate(value, "lab:law", 1.25)
+    assert says in str(err.value) and "at t = 1.250 s" in str(err.value)
+
+
+def test_a_rate_is_returned_as_a_float():
+    assert checked_rate(np.float64(1.5), "x:y", 0.0) == 1.5
+    assert checked_rate(2, "x:y", 0.0) == 2.0
+
+
+def test_law_inputs_work_out_alpha_and_the_lead():
+    """alpha: omega_f along the unit tangent; lead: the CoM ahead of x_d along it."""
+    inputs = LawInputs.of(
+        CONFIG,
+        tangent_W=[0.0, 0.0, 0.2],
+        omega_f_W=[0.3, 0.0, 0.4],
+        com_W=[0.1, 0.0, 0.45],
+        x_d_W=[0.1, 0.0, 0.4],
+    )
+    assert inputs.alpha == pytest.approx(0.4)
+    assert inputs.lead_m == pytest.approx(0.05)
+    with pytest.raises(AttributeError, match="LawInputs has no 'nope'"):
+        _ = inputs.nope
+    with pytest.raises(KeyError, match="'psi' was not given"):
+        _ = inputs.psi
+
+
+@pytest.mark.parametrize("law", [tangent_law, interaction_law])
+def test_the_shipped_laws_are_the_gated_law_of_the_paper(law):
+    """Through LawInputs, each shipped law gives what psi_dot_law gives for its ratio."""
+    rng = np.random.default_rng(7)
+    name = "tangent" if law is tangent_law else "interaction"
+    config = AdvancementConfig(alpha_full_mps2=0.6, law=name)
+    for _ in range(50):
+        v, omega_f, tangent = rng.normal(0, 0.3, (3, 3))
+        lead, progress = rng.uniform(-0.02, 0.02), rng.uniform(0, 1)
+        inputs = LawInputs.of(
+            config,
+            com_velocity_W=v,
+            omega_f_W=omega_f,
+            tangent_W=tangent,
+            lead_m=lead,
+            progress=progress,
+        )
+        expected = psi_dot_law(config, v, omega_f, tangent, lead, progress)[0]
+        assert law(inputs) == expected
+
+
+def _bad_law_run(spec: str, tmp_path: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [
+            sys.executable,
+            str(REPO / "run_diagram.py"),
+            "--no-recording",
+            "--duration",
+            "5.0",
+            "--set",
+            f"advancement.law={spec}",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=REPO / "tests" / "plugins",
+        timeout=600,
+    )
+
+
+@pytest.mark.parametrize(
+    ("spec", "says"),
+    [
+        ("no_such_module_xyz:law", "does not import"),
+        ("lab_laws:two_arguments", "has the signature"),
+        ("lab_laws:returns_nan", "returned nan at t = "),
+        ("lab_laws:returns_pair", "returned shape (2,) at t = "),
+    ],
+)
+def test_run_diagram_refuses_a_bad_law_with_one_line_and_exit_2(spec, says, tmp_path):
+    """Before the run (the import, the signature) or at the law's first call (its value,
+    once the rise advances): one `error:` line, exit code 2, no traceback."""
+    done = _bad_law_run(spec, tmp_path)
+    assert done.returncode == 2, done.stderr
+    errors = [line for line in done.stderr.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and errors[0].startswith("error: advancement.law: ")
+    assert says in errors[0] and "Traceback" not in done.stderr
+    assert done.stderr.strip().splitlines()[-1] == errors[0]  # after the progress bar only
+
+
+def _metrics(*overrides: str) -> dict:
+    from drake_standup.sim.simulate import simulate
+
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml", [parse_set(o) for o in overrides])
+    return simulate(scenario, None, record=False, progress=False, baseline=False).metrics
+
+
+@pytest.mark.slow
+def test_a_law_outside_the_package_runs_as_the_same_law_inside_it():
+    """The shipped tangent law named by module:attribute from outside the package gives the
+    shipped run to the last bit, and a law of its own (psi_dot 1.3 while helped) stands
+    up between psi = t and the shipped law."""
+    shipped = _metrics()
+    outside = _metrics("advancement.law=lab_laws:copy_of_tangent")
+    for key in ("standup_time_s", "psi_final", "sole_force_chatter_N", "com_tracking_rms_m"):
+        assert outside.get(key) == shipped.get(key), key
+    constant = _metrics("advancement.law=lab_laws:constant")
+    plain = _metrics("advancement.enabled=false")
+    assert constant["success"]
+    assert shipped["standup_time_s"] < constant["standup_time_s"] < plain["standup_time_s"]
