@@ -1,0 +1,88 @@
+"""The example's plug-ins: the law against hand-worked values, both names by entry point,
+and each driving a stand-up (slow). Needs the example installed:
+pip install -e examples/bring_your_own."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+bring_your_own = pytest.importorskip("bring_your_own")
+
+from bring_your_own.laws import GAIN_S2_PER_M, gated_law  # noqa: E402
+
+from drake_standup.config import SCENARIO_DIR, AdvancementConfig, load_scenario  # noqa: E402
+from drake_standup.config.arguments import parse_set  # noqa: E402
+from drake_standup.plugins import LawInputs, registered  # noqa: E402
+
+CONFIG = AdvancementConfig()
+
+
+def _inputs(**values):
+    base = {"alpha": 0.5, "lead_m": 0.0, "progress": 0.1}
+    return LawInputs.of(CONFIG, **{**base, **values})
+
+
+def test_the_gated_law_against_hand_worked_values():
+    """1 + GAIN (alpha - alpha_min) within the gates; 1 without help or with the CoM
+    lagging; half the excess half-way through the taper; the bound on top."""
+    excess = GAIN_S2_PER_M * (0.5 - CONFIG.alpha_min_mps2)
+    assert gated_law(_inputs()) == pytest.approx(1.0 + excess)
+    assert gated_law(_inputs(alpha=CONFIG.alpha_min_mps2)) == 1.0
+    assert gated_law(_inputs(lead_m=-2.0 * CONFIG.lag_tolerance_m)) == 1.0
+    half = CONFIG.taper_from_progress + 0.5 * (1.0 - CONFIG.taper_from_progress)
+    assert gated_law(_inputs(progress=half)) == pytest.approx(1.0 + 0.5 * excess)
+    assert gated_law(_inputs(alpha=10.0)) == CONFIG.psi_dot_upper
+
+
+def test_the_law_reads_alpha_from_the_path_and_the_pull():
+    """alpha worked out from tangent_W and omega_f_W when not given: the pull's CoM
+    acceleration along the path's unit tangent."""
+    inputs = LawInputs.of(
+        CONFIG,
+        tangent_W=[0.1, 0.0, 0.0],
+        omega_f_W=[0.4, 0.0, 0.3],
+        lead_m=0.0,
+        progress=0.0,
+    )
+    assert inputs.alpha == pytest.approx(0.4)
+    assert gated_law(inputs) == pytest.approx(1.0 + GAIN_S2_PER_M * (0.4 - 0.05))
+
+
+def test_the_entry_points_are_listed():
+    """Installed, the example's names are the registry's and `drake-standup list` shows them."""
+    assert registered("laws")["gated"].obj is gated_law
+    assert "bring-your-own" in registered("helpers")["sway"].origin
+    listing = subprocess.run(
+        [sys.executable, "-m", "drake_standup", "list"], capture_output=True, text=True, check=True
+    ).stdout
+    assert "gated" in listing and "sway" in listing
+
+
+def _run(*overrides):
+    from drake_standup.sim.simulate import simulate
+
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml", [parse_set(o) for o in overrides])
+    return simulate(scenario, None, record=False, progress=False, baseline=False).metrics
+
+
+@pytest.mark.slow
+def test_the_law_by_entry_point_and_by_module_attribute_is_one_law():
+    """Named both ways, the law gives the same run to the last bit, and it stands up
+    sooner than psi = t under the same pull."""
+    by_name = _run("advancement.law=gated")
+    by_path = _run("advancement.law=bring_your_own.laws:gated_law")
+    stiff = _run("advancement.enabled=false")
+    assert by_name["success"] and by_path["success"]
+    for key in ("standup_time_s", "psi_final", "sole_force_chatter_N"):
+        assert by_name[key] == by_path[key]
+    assert by_name["standup_time_s"] < stiff["standup_time_s"] - 0.1
+
+
+@pytest.mark.slow
+def test_the_swaying_helper_stands_the_robot_up():
+    """The example's helper, by its entry point name, with the example's law."""
+    metrics = _run("human.mode=sway", "advancement.law=gated")
+    assert metrics["success"], metrics["failure_reason"]
+    assert np.isfinite(metrics["standup_time_s"])
