@@ -130,7 +130,21 @@ _BARE_FILE = re.compile(r"(?<![\w./-])([A-Za-z_]\w*\.py)\b")
 # `module.name` or `module.Class.name` in backticks (docs), or a module-qualified name in
 # a docstring or comment: module is one of the package's modules, by its file's name.
 _QUALIFIED = re.compile(r"(?<![\w.])([a-z_][a-z0-9_]*)\.([A-Za-z_]\w*)(?:\.([A-Za-z_]\w*))?")
-_SUFFIXES = {"py", "md", "yaml", "json", "npz", "png", "html", "csv", "sdf", "dot", "svg"}
+_SUFFIXES = {
+    "py",
+    "md",
+    "yaml",
+    "json",
+    "npz",
+    "png",
+    "html",
+    "csv",
+    "sdf",
+    "obj",
+    "stl",
+    "dot",
+    "svg",
+}
 # The scenario's sections (config.Scenario's fields): `section.key` is a key.
 _SECTIONS = {
     "robot",

@@ -2,12 +2,15 @@
 simulates.
 
 Every failure is a ScenarioError: one line naming the option or key, the value, and what
-it accepts. rules.validate calls the checks of a scenario's own keys (chair.file, the
-robot model's frames, joints and bodies); the entry points those of their options
-(--scenario and a sweep file through read_text_file, --out through check_output_dir).
+it accepts. rules.validate calls the checks of a scenario's own keys (chair.file: an SDF,
+or a mesh read by config/chair_mesh.py; the robot model's frames, joints and bodies); the
+entry points those of their options (--scenario and a sweep file through read_text_file,
+--out through check_output_dir). load_scenario sets a mesh chair's seat height from the
+mesh (with_mesh_seat).
 """
 
 import contextlib
+import dataclasses
 import functools
 import logging
 import xml.etree.ElementTree as ET
@@ -22,11 +25,36 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import DiagramBuilder
 
-from drake_standup.config.chair import chair_file
+from drake_standup.config.chair import ChairConfig, chair_file
+from drake_standup.config.chair_mesh import (
+    MIN_SEAT_DEPTH_M,
+    MIN_SEAT_WIDTH_M,
+    SEAT_HEIGHTS_M,
+    ChairMesh,
+    MeshError,
+    is_mesh,
+    read_chair_mesh,
+)
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.resources import model_file
 
 # --- Files and folders -------------------------------------------------------------------
+
+
+def read_file_bytes(path: Path | str, key: str, accepted: str) -> bytes:
+    """The bytes of the file at path; an error naming key if the file is missing, a
+    folder or unreadable. accepted: what key accepts, for the message."""
+    path = Path(path)
+    if path.is_dir():
+        raise ScenarioError(f"{key}: '{path}' is a folder; accepted: {accepted}")
+    try:
+        return path.read_bytes()
+    except FileNotFoundError:
+        raise ScenarioError(f"{key}: file '{path}' not found; accepted: {accepted}") from None
+    except OSError as err:
+        raise ScenarioError(
+            f"{key}: '{path}' cannot be read ({err.strerror}); accepted: a file this user can read"
+        ) from None
 
 
 def read_text_file(path: Path | str, key: str, accepted: str) -> str:
@@ -34,16 +62,7 @@ def read_text_file(path: Path | str, key: str, accepted: str) -> str:
     naming key if the file is missing, a folder, unreadable or not UTF-8 text. accepted:
     what key accepts, for the message."""
     path = Path(path)
-    if path.is_dir():
-        raise ScenarioError(f"{key}: '{path}' is a folder; accepted: {accepted}")
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise ScenarioError(f"{key}: file '{path}' not found; accepted: {accepted}") from None
-    except OSError as err:
-        raise ScenarioError(
-            f"{key}: '{path}' cannot be read ({err.strerror}); accepted: a file this user can read"
-        ) from None
+    data = read_file_bytes(path, key, accepted)
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as err:
@@ -73,28 +92,66 @@ def check_output_dir(path: Path | str, key: str = "--out") -> Path:
     return path
 
 
-# --- The chair: an SDF file the scene welds to the world at its frame 'chair' -------------
+# --- The chair: an SDF file the scene welds to the world at its frame 'chair', or a mesh --
 
 CHAIR_FRAME = "chair"
 CHAIR_FILES = (
-    "an SDF file path (absolute or relative to the current directory), or models/chair.sdf"
+    "an SDF, OBJ or STL file path (absolute or relative to the current directory), or "
+    "models/chair.sdf or models/chair_mesh.obj"
 )
 CHAIR_CONTENT = (
     f"an SDF file of one model with a link or frame named '{CHAIR_FRAME}' (the scene welds "
     "it to the world), e.g. models/chair.sdf"
 )
+_LOW, _HIGH = SEAT_HEIGHTS_M
+CHAIR_MESH_CONTENT = (
+    "a closed OBJ or STL mesh (m, z up, x forward) with an upward horizontal seat "
+    f"{_LOW:g}-{_HIGH:g} m above its lowest point, at least {MIN_SEAT_DEPTH_M:g} m deep and "
+    f"{MIN_SEAT_WIDTH_M:g} m wide, e.g. models/chair_mesh.obj"
+)
 
 
 def check_chair_file(name: str) -> Path:
     """chair.file's path, checked: a UTF-8 SDF file that Drake parses into one model with
-    a frame named 'chair' that can be welded to the world, as scene.add_scene does."""
+    a frame named 'chair' that can be welded to the world, as scene.add_scene does; or a
+    chair mesh (chair_mesh)."""
     path = chair_file(name)
+    if is_mesh(path):
+        chair_mesh(name)
+        return path
     read_text_file(path, "chair.file", CHAIR_FILES)
     stat = path.stat()
     problem = _sdf_problem(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
     if problem:
         raise ScenarioError(f"chair.file: '{name}' {problem}; accepted: {CHAIR_CONTENT}")
     return path
+
+
+def chair_mesh(name: str) -> ChairMesh:
+    """chair.file (an .obj or .stl) read as a chair mesh, and its seat
+    (config/chair_mesh.py); a ScenarioError (one line) if it cannot be one."""
+    path = chair_file(name)
+    data = read_file_bytes(path, "chair.file", CHAIR_FILES)
+    try:
+        return _read_mesh(data, path.suffix.lower())
+    except MeshError as err:
+        raise ScenarioError(f"chair.file: '{name}' {err}; accepted: {CHAIR_MESH_CONTENT}") from None
+
+
+@functools.lru_cache(maxsize=8)
+def _read_mesh(data: bytes, suffix: str) -> ChairMesh:
+    """Cached per file content: a sweep validates every run, and the scene reads it again."""
+    return read_chair_mesh(data, suffix)
+
+
+def with_mesh_seat(chair: ChairConfig) -> ChairConfig:
+    """chair, its seat_height_m the mesh's (to the micrometre) if chair.file is a mesh:
+    with a mesh, the seat's height is read from the mesh, whatever the scenario says
+    (load_scenario applies this; the scene refuses a mesh chair whose height disagrees)."""
+    if not chair.file or not is_mesh(chair.file):
+        return chair
+    height = round(chair_mesh(chair.file).seat.height_m, 6)
+    return dataclasses.replace(chair, seat_height_m=height)
 
 
 def add_sdf(parser: Parser, path: Path) -> list[ModelInstanceIndex]:

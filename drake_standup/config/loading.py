@@ -7,6 +7,7 @@ line) are one more YAML layer through the same loader. What the types alone cann
 (bounds, accepted values, lengths) is checked by config/rules.py.
 """
 
+import dataclasses
 import re
 import reprlib
 import typing
@@ -17,7 +18,7 @@ import yaml
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 
 from drake_standup.config.errors import ScenarioError
-from drake_standup.config.inputs import read_text_file
+from drake_standup.config.inputs import read_text_file, with_mesh_seat
 from drake_standup.config.legacy import read_legacy
 from drake_standup.config.resources import find, shipped
 from drake_standup.config.rules import _format, _nodes, _pattern, validate, with_hardware
@@ -48,7 +49,8 @@ def parse_scenario(text: str, where: str = "scenario", overrides: Iterable = ())
 
 
 def apply_overrides(scenario: Scenario, overrides: Iterable) -> Scenario:
-    """A copy of scenario with each (key path, value) set, validated.
+    """A copy of scenario with each (key path, value) set, validated (and, with a mesh
+    chair, chair.seat_height_m set from the mesh).
 
     The overrides are one more YAML layer: the top-level keys they touch, written out
     whole with the values set, loaded by yaml_load_typed with scenario as the defaults:
@@ -59,7 +61,9 @@ def apply_overrides(scenario: Scenario, overrides: Iterable) -> Scenario:
     for path, value in overrides:
         top = _set(data, path, value)
         layer[top] = data[top]
-    return validate(with_hardware(_load(layer, scenario)))
+    scenario = validate(with_hardware(_load(layer, scenario)))
+    # A mesh chair's seat height is the mesh's (config/inputs.py with_mesh_seat).
+    return dataclasses.replace(scenario, chair=with_mesh_seat(scenario.chair))
 
 
 def expand_key_path(scenario: Scenario, path: str) -> list[str]:

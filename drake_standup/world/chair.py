@@ -4,11 +4,22 @@ chair_sdf writes it as SDF text: a seat board whose top is at seat_height_m (rig
 hydroelastic), optionally a cushion on it (compliant hydroelastic, its top at
 seat_height_m), four legs and a backrest for show. Its frame 'chair' is on the floor
 below the seat's front edge, x forward, as models/chair.sdf (the same chair as a file).
+
+mesh_chair_sdf writes a chair mesh (chair.file an .obj or .stl, config/chair_mesh.py) as
+SDF text: the mesh, written again as a plain OBJ where Drake reads it, is the chair's
+collision (rigid hydroelastic, all of it) and visual geometry, posed so that the frame
+'chair' is on the floor below the middle of the seat's front edge.
 """
 
 from __future__ import annotations
 
+import hashlib
+import os
+import tempfile
+from pathlib import Path
+
 from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig
+from drake_standup.config.chair_mesh import ChairMesh, obj_text
 
 # The shipped chair's look (models/chair.sdf): seat 0.40 m deep, 0.44 m wide; legs
 # 0.04 m square, inset 0.03 m; a backrest 0.03 m thick from 0.02 m above the seat. m.
@@ -83,3 +94,40 @@ def chair_sdf(chair: ChairConfig) -> str:
         + "".join(parts)
         + "    </link>\n  </model>\n</sdf>\n"
     )
+
+
+def mesh_chair_sdf(chair: ChairConfig, mesh: ChairMesh) -> str:
+    """The chair mesh as SDF text, with chair's friction (its seat height is the mesh's:
+    config/inputs.py with_mesh_seat)."""
+    seat = mesh.seat
+    pose = f"{-seat.front_edge_x_m:.9g} {-seat.centre_y_m:.9g} {-seat.floor_z_m:.9g} 0 0 0"
+    geometry = f"<geometry><mesh><uri>{cached_obj(mesh).as_uri()}</uri></mesh></geometry>"
+    parts = [
+        f'      <{kind} name="{name}">\n        <pose>{pose}</pose>\n        {geometry}\n'
+        f"{body}      </{kind}>\n"
+        for kind, name, body in (
+            ("collision", "chair_collision", _proximity(chair.friction, None)),
+            ("visual", "chair", _material(_WOOD)),
+        )
+    ]
+    return (
+        '<?xml version="1.0"?>\n<sdf version="1.9" xmlns:drake="http://drake.mit.edu">\n'
+        '  <model name="chair">\n    <link name="chair">\n'
+        + "".join(parts)
+        + "    </link>\n  </model>\n</sdf>\n"
+    )
+
+
+def cached_obj(mesh: ChairMesh) -> Path:
+    """The mesh as a plain OBJ file (Drake reads OBJ, not STL), in the temporary folder,
+    named by its content: written once, atomically, for every run that loads it."""
+    text = obj_text(mesh)
+    folder = Path(tempfile.gettempdir()) / "drake_standup_chairs"
+    path = folder / f"{hashlib.sha256(text.encode()).hexdigest()[:20]}.obj"
+    if not path.is_file():
+        folder.mkdir(parents=True, exist_ok=True)
+        handle, part = tempfile.mkstemp(".obj", dir=folder)
+        with os.fdopen(handle, "w") as f:
+            f.write(text)
+        os.replace(part, path)
+    return path

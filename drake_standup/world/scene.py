@@ -16,16 +16,18 @@ from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, SceneGraph
 from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Context, DiagramBuilder
 
-from drake_standup.config import Scenario, ScenarioError, chair_file
-from drake_standup.config.inputs import add_sdf
+from drake_standup.config import ChairConfig, Scenario, ScenarioError, chair_file
+from drake_standup.config.chair_mesh import is_mesh
+from drake_standup.config.inputs import add_sdf, chair_mesh
 from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.helper.body import GRIPS, HelperBody, add_helper_body
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
 from drake_standup.robot.last_com import LastCoM
-from drake_standup.world.chair import chair_sdf
+from drake_standup.world.chair import chair_sdf, mesh_chair_sdf
 from drake_standup.world.perturbations import scale_friction
 from drake_standup.world.seating import SeatedPose, seated_pose
 
@@ -168,11 +170,7 @@ def add_scene(
             joint.set_default_damping(joint.default_damping() + added[joint.name()])
     parser = Parser(plant)
     (floor,) = add_sdf(parser, model_file("floor.sdf"))
-    # One model with a frame 'chair' (config.validate parsed a user's file so).
-    if scenario.chair.file:
-        (chair,) = add_sdf(parser, chair_file(scenario.chair.file))
-    else:
-        (chair,) = parser.AddModelsFromString(chair_sdf(scenario.chair), "sdf")
+    chair = _add_chair(parser, scenario.chair)
     world = plant.world_frame()
     plant.WeldFrames(world, plant.GetFrameByName("floor", floor))
     plant.WeldFrames(
@@ -198,6 +196,25 @@ def add_scene(
     scene = Scene(plant, scene_graph, robot, seated, helper, alone, added_damping=added)
     scene.standing = StandingGeometry(scene, scenario.initial.base_rpy_rad[2])
     return scene
+
+
+def _add_chair(parser: Parser, chair: ChairConfig) -> ModelInstanceIndex:
+    """The chair's model, with a frame 'chair' (config.validate checked a user's file): the
+    one of chair's numbers, a user's SDF file, or a mesh whose seat height chair has."""
+    if not chair.file:
+        (model,) = parser.AddModelsFromString(chair_sdf(chair), "sdf")
+    elif is_mesh(chair.file):
+        mesh = chair_mesh(chair.file)
+        if abs(chair.seat_height_m - mesh.seat.height_m) > 5e-4:
+            raise ScenarioError(
+                f"chair.seat_height_m: {chair.seat_height_m:g}; accepted: "
+                f"{mesh.seat.height_m:.4f}, the seat of chair.file '{chair.file}' (a mesh: "
+                "load_scenario sets it so)"
+            )
+        (model,) = parser.AddModelsFromString(mesh_chair_sdf(chair, mesh), "sdf")
+    else:
+        (model,) = add_sdf(parser, chair_file(chair.file))
+    return model
 
 
 def robot_last_com(scene: Scene) -> LastCoM:

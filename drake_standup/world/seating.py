@@ -24,6 +24,7 @@ from pydrake.solvers import MathematicalProgram, Solve
 
 from drake_standup.config import Scenario, ScenarioError
 from drake_standup.config.chair import SEATED_BASE_XYZ_M, SEATED_JOINTS, ChairConfig, InitialPose
+from drake_standup.config.chair_mesh import is_mesh
 from drake_standup.robot.icub import add_icub
 from drake_standup.world.chair import SEAT_DEPTH_M
 
@@ -280,8 +281,12 @@ def _cannot_sit(scenario: Scenario) -> str:
             "sit that far behind the seat's edge with its soles flat on the floor; accepted: "
             "null (as deep as the seat allows) or a depth it sits at on the shipped seat"
         )
+    # A mesh's seat height is the mesh's (config/inputs.py with_mesh_seat): name the file.
+    key = f"chair.seat_height_m: {chair.seat_height_m:g}"
+    if is_mesh(chair.file):
+        key = f"chair.file: '{chair.file}' (its seat {chair.seat_height_m:g} m high)"
     return (
-        f"chair.seat_height_m: {chair.seat_height_m:g}; the {scenario.robot.model} cannot sit "
+        f"{key}; the {scenario.robot.model} cannot sit "
         f"on this chair with its soles flat on the floor"
         + (" where initial.* place it" if _placed(scenario.initial) else "")
         + f"; accepted: a seat {low:.3f}-{high:.3f} m high (its top above the floor)"

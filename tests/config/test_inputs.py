@@ -61,7 +61,8 @@ CHAIR_CONTENT = (
     "world), e.g. models/chair.sdf"
 )
 CHAIR_FILES = (
-    "an SDF file path (absolute or relative to the current directory), or models/chair.sdf"
+    "an SDF, OBJ or STL file path (absolute or relative to the current directory), or "
+    "models/chair.sdf or models/chair_mesh.obj"
 )
 UTF8 = "a text file saved as UTF-8"
 LATIN1 = "duration_s: 1.0\n# café\n".encode("latin-1")
