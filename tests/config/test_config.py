@@ -242,9 +242,10 @@ def test_every_rule_names_a_key():
 # Values no rule bounds, and why: angles and names that only the model can check (the
 # joint limits clamp the posture targets; the names are checked against the model's URDF:
 # config.JOINT_TABLES, the pushed bodies), the model and the chair file (config/inputs.py),
-# lead_max_m (checked against lead_min_m).
+# the recorded helper's file (config/recording.py), lead_max_m (checked against lead_min_m).
 UNBOUNDED = (
-    r"robot\.model|chair\.file|initial\.joints_rad\..*|phases\.\w+\.posture_rad\..*"
+    r"robot\.model|chair\.file|human\.recorded\.file|initial\.joints_rad\..*"
+    r"|phases\.\w+\.posture_rad\..*"
     r"|phases\.\w+\.base_pitch_rad"
     r"|controller\.seat_hinge_joints\[\d+\]|perturbation\.pushes\[\d+\]\.body"
     r"|human\.reactive\.lead_max_m"
