@@ -34,7 +34,7 @@ def needs_baseline(scenario: Scenario) -> bool:
     """Whether psi could advance: the advancement response, advancement on and somebody
     pulling. Otherwise the run is its own psi = t run."""
     human = scenario.human
-    pulled = human.mode in ("reactive", "body") or bool(human.pulls)
+    pulled = human.mode in ("reactive", "body", "recorded") or bool(human.pulls)
     return scenario.response == "advancement" and scenario.advancement.enabled and pulled
 
 

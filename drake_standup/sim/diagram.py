@@ -20,6 +20,7 @@ from drake_standup.config import RESPONSES, Scenario, validate
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.helper.body_control import make_body_helper
 from drake_standup.helper.hands import HumanWrenchSource
+from drake_standup.helper.recorded import make_recorded_helper
 from drake_standup.helper.work import HelperWork
 from drake_standup.robot.icub import actuated_joints
 from drake_standup.senses.wiring import add_muscles, add_senses, joint_damping
@@ -148,8 +149,9 @@ def _add_station_and_human(
             "human", make_body_helper(station.plant, station.robot, scenario.human, helper, intent)
         )
     else:
+        default = make_recorded_helper if scenario.human.mode == "recorded" else HumanWrenchSource
         human = builder.AddNamedSystem(
-            "human", (make_human or HumanWrenchSource)(station.plant, station.robot, scenario.human)
+            "human", (make_human or default)(station.plant, station.robot, scenario.human)
         )
     builder.Connect(world.GetOutputPort("robot_state"), human.GetInputPort("robot_state"))
     builder.Connect(
