@@ -7,6 +7,7 @@ rules.py       the bounds and accepted values of every field, the keys naming jo
                checks across fields, and validate: the one check of a scenario
 inputs.py      the files, folders and robot names a user gives (read_text_file, the chair
                file, the robot model's frames, check_output_dir)
+recording.py   human.recorded: the recorded helper's settings, its CSV file read and checked
 errors.py      ScenarioError: one line naming the key or file
 """
 

@@ -44,6 +44,7 @@ SHIPPED = {
         "scripted": "drake_standup.helper.hands:HumanWrenchSource",
         "reactive": "drake_standup.helper.hands:HumanWrenchSource",
         "body": "drake_standup.helper.body_control:body_helper",
+        "recorded": "drake_standup.helper.recorded:make_recorded_helper",
     },
 }
 CHECKS = {

@@ -1,5 +1,5 @@
 """The files the package ships: the robot's contact pads, chair and floor (models/), the
-scenarios (scenarios/) and the sweeps (sweeps/).
+scenarios (scenarios/), the sweeps (sweeps/) and the recorded helpers' files (recordings/).
 
 In the repository they are top-level folders; a wheel carries them inside the package as
 drake_standup/data/<folder> (setup.py). Both are read here, through importlib.resources,
@@ -12,12 +12,13 @@ import importlib.resources
 import re
 from pathlib import Path
 
-FOLDERS = ("models", "scenarios", "sweeps")
+FOLDERS = ("models", "scenarios", "sweeps", "recordings")
 
 
 def data_root() -> Path:
-    """The folder holding models/, scenarios/ and sweeps/: the installed package's data/,
-    or, run from a checkout (editable install or PYTHONPATH), the repository's root."""
+    """The folder holding models/, scenarios/, sweeps/ and recordings/: the installed
+    package's data/, or, run from a checkout (editable install or PYTHONPATH), the
+    repository's root."""
     package = Path(str(importlib.resources.files("drake_standup")))
     installed = package / "data"
     return installed if installed.is_dir() else package.parent

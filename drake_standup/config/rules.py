@@ -23,6 +23,7 @@ from drake_standup.config.errors import ScenarioError
 from drake_standup.config.hardware import HARDWARE
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
 from drake_standup.config.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
+from drake_standup.config.recording import FRAMES, load_recording
 from drake_standup.config.scenario import REFLECTED_INERTIA, RESPONSES, Scenario
 
 
@@ -67,6 +68,7 @@ PLANT_STEP = Range(
 # patterns separated by spaces, '*' standing for any part of a name and '[*]' for any list
 # index. Checked in this order (tests/config/test_config.py: every pattern names a key).
 RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
+    (FRAMES, "human.recorded.frame"),
     (TONES, "human.body.tone"),
     # An adult the anthropometric table scales to (issue 32). m, kg.
     (Range(low=1.5, high=1.95), "human.body.height_m"),
@@ -231,7 +233,8 @@ def _check(key: str, value, accepted) -> None:
 def validate(scenario: Scenario) -> Scenario:
     """The one check of a scenario before anything simulates: RULES, the checks across
     fields, the robot model's names (its frames, and every joint and body the scenario
-    names) and the chair file. Raises ScenarioError (one line); returns scenario."""
+    names), the chair file and the recorded helper's file. Raises ScenarioError (one
+    line); returns scenario."""
     data = yaml.safe_load(yaml_dump_typed(scenario))
     _check_rules(data)
     _check_across_fields(scenario)
@@ -239,6 +242,8 @@ def validate(scenario: Scenario) -> Scenario:
     if scenario.chair.file:
         check_chair_file(scenario.chair.file)
     _check_plugins(scenario)
+    if scenario.human.mode == "recorded":
+        load_recording(scenario.human.recorded.file)
     if scenario.controller.model_library == "pinocchio":
         import importlib.util
 

@@ -14,6 +14,7 @@ from drake_standup.config.chair import ChairConfig, InitialPose
 from drake_standup.config.controller import ControllerConfig
 from drake_standup.config.hardware import HardwareConfig
 from drake_standup.config.phases import PhaseTable
+from drake_standup.config.recording import RecordedHelperConfig
 from drake_standup.config.resources import data_root
 
 SCENARIO_DIR = data_root() / "scenarios"
@@ -135,12 +136,14 @@ class ReactiveHumanConfig:
 @dataclass
 class HumanConfig:
     # scripted: the pulls below; reactive: the impedance helper (reactive:); body: a
-    # person's body pulling with reactive:'s intent (body:, helper/body.py).
+    # person's body pulling with reactive:'s intent (body:, helper/body.py); recorded:
+    # hand forces replayed from a CSV file (recorded:, helper/recorded.py).
     mode: str = "scripted"
     # Empty list: nobody helps.
     pulls: list[Pull] = field(default_factory=list)
     reactive: ReactiveHumanConfig = field(default_factory=ReactiveHumanConfig)
     body: BodyHelperConfig = field(default_factory=BodyHelperConfig)
+    recorded: RecordedHelperConfig = field(default_factory=RecordedHelperConfig)
 
 
 @dataclass

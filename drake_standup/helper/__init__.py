@@ -7,7 +7,9 @@ One word for each kind (human.mode in a scenario):
 - body: a person's body kneeling in front of the robot, with their own joints, strength
   and grips (anthropometry.py: the body from de Leva's table; body.py: that body in the
   plant, placed, its strength and impedance; body_control.py: the person's controller
-  and the grips).
+  and the grips);
+- recorded: a person's hand wrenches replayed from a CSV file (recorded.py; the file's
+  format: docs/helpers.md).
 
 Which module holds what, and the ports the diagram (sim/diagram.py) reads:
     hands.py          HumanWrenchSource (scripted, reactive): robot_state in;
@@ -17,6 +19,8 @@ Which module holds what, and the ports the diagram (sim/diagram.py) reads:
     body.py           HelperBody: the person in the plant, placement, strength, grip frames
     body_control.py   make_body_helper: the person's controller and the Grips, with
                       HumanWrenchSource's ports (the robot feels the grips)
+    recorded.py       make_recorded_helper: RecordedWrenchSource (recorded), the
+                      recording interpolated in time, HumanWrenchSource's ports
     work.py           HelperWork: work, impulse and peak force over the plant's steps
                       (helper_spent, 4)
 

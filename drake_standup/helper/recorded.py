@@ -1,0 +1,142 @@
+"""The recorded helper (human.mode: recorded): a person's hand wrenches replayed from a
+CSV file (config/recording.py reads and checks it; its format: docs/helpers.md).
+
+RecordedWrenchSource has HumanWrenchSource's ports (helper/hands.py): robot_state in
+(read only when the samples are in the hand frame); hand_wrenches_W (12: [torque_l,
+force_l, torque_r, force_r]) and spatial_forces out. Each time its output is computed it
+interpolates the samples linearly at the context's time (zero before the first sample
+and after the last), rotates them into the world if they are in the hand frame, and
+applies torques as well as forces at the hand frame's origin.
+
+write_scripted_recording writes a scenario's scripted pulls as such a file, sampled as a
+force plate would log them: the shipped recordings/default_pull.csv is the default
+scenario's pull (tools/record_default_pull.py), not a measurement of a person.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from pydrake.common.value import Value
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
+from pydrake.systems.framework import BasicVector, Context, LeafSystem
+
+from drake_standup.config import HumanConfig, load_scenario
+from drake_standup.config.recording import load_recording, write_recording
+from drake_standup.helper.hands import TASK_FRAMES, hand_forces, scripted_forces
+from drake_standup.ports.caching import declare_cached
+from drake_standup.robot.icub import Robot
+
+# A force plate's rate: the shipped recording's samples. Hz.
+PLATE_RATE_HZ = 1000.0
+# A written recording's forces are rounded to this many decimals of a newton: far below
+# a force plate's resolution, and a ramp's samples read as the decimals they are (0.03 N
+# a millisecond on the default pull's, not 0.029999999999996696).
+FORCE_DECIMALS = 6
+
+
+def applied_wrenches(
+    applied: list[ExternallyAppliedSpatialForce], hand_wrenches_W: np.ndarray
+) -> list[ExternallyAppliedSpatialForce]:
+    """applied (hand_forces) set to hand_wrenches_W's torques and forces, the hands
+    whose wrench is not zero only (none: the plant then has nothing to apply)."""
+    pulled = []
+    for force, wrench in zip(applied, hand_wrenches_W.reshape(2, 6)):
+        if np.count_nonzero(wrench):
+            force.F_Bq_W = SpatialForce(wrench[:3], wrench[3:])
+            pulled.append(force)
+    return pulled
+
+
+class RecordedWrenchSource(LeafSystem):
+    """A recording's wrenches on the robot's hands, at the hand frames' origins."""
+
+    def __init__(self, plant: MultibodyPlant, robot: Robot, config: HumanConfig):
+        super().__init__()
+        recording = load_recording(config.recorded.file)
+        self._times = recording.times_s
+        # One row per column of hand_wrenches_W: what np.interp reads per column.
+        self._columns = np.ascontiguousarray(recording.wrenches.T)
+        self._in_hand = config.recorded.frame == "hand"
+        self._plant, self._instance = plant, robot.model_instance
+        self._context = plant.CreateDefaultContext()
+        self._frames = [robot.frame(plant, name) for name in TASK_FRAMES]
+        self._applied = hand_forces(plant, robot)
+        nx = plant.num_multibody_states(self._instance)
+        self._state = self.DeclareVectorInputPort("robot_state", nx)
+        prereq = {self.time_ticket()}
+        if self._in_hand:
+            prereq.add(self._state.ticket())
+        # In the world frame the wrenches are a function of time alone: the last time and
+        # its wrenches (the integrator sets a step's end time twice, a change to Drake).
+        self._last: tuple[float, np.ndarray] | None = None
+        self._wrenches_cache = declare_cached(self, "hand wrenches", self._wrenches, prereq)
+        prereq = {self._wrenches_cache.ticket()}
+        self.DeclareVectorOutputPort(
+            "hand_wrenches_W", 12, self._CalcWrenches, prerequisites_of_calc=prereq
+        )
+        self.DeclareAbstractOutputPort(
+            "spatial_forces",
+            lambda: Value[list[ExternallyAppliedSpatialForce]]([]),
+            self._CalcSpatialForces,
+            prerequisites_of_calc=prereq,
+        )
+
+    def sampled(self, t: float) -> np.ndarray:
+        """(12,) the recording at time t in its own frame: each column interpolated
+        linearly between the samples around t, zero outside the recording."""
+        times = self._times
+        return np.array(
+            [np.interp(t, times, column, left=0.0, right=0.0) for column in self._columns]
+        )
+
+    def _wrenches(self, context: Context) -> np.ndarray:
+        """hand_wrenches_W (12,): the recording at the context's time, in the world."""
+        t = context.get_time()
+        if self._in_hand:
+            return self._to_world(context, self.sampled(t))
+        if self._last is None or self._last[0] != t:
+            self._last = t, self.sampled(t)
+        return self._last[1]
+
+    def _to_world(self, context: Context, wrenches_H: np.ndarray) -> np.ndarray:
+        """wrenches_H (12,), each hand's torque and force in its hand frame, rotated by
+        that frame's orientation in the world now (R_WH)."""
+        plant, c = self._plant, self._context
+        plant.SetPositionsAndVelocities(c, self._instance, self._state.Eval(context))
+        wrenches = np.empty(12)
+        for i, frame in enumerate(self._frames):
+            R_WH = frame.CalcRotationMatrixInWorld(c).matrix()
+            for part in (slice(6 * i, 6 * i + 3), slice(6 * i + 3, 6 * i + 6)):
+                wrenches[part] = R_WH @ wrenches_H[part]
+        return wrenches
+
+    def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
+        output.SetFromVector(self._wrenches_cache.Eval(context))
+
+    def _CalcSpatialForces(self, context: Context, output) -> None:
+        output.set_value(applied_wrenches(self._applied, self._wrenches_cache.Eval(context)))
+
+
+def make_recorded_helper(
+    plant: MultibodyPlant, robot: Robot, human_config: HumanConfig
+) -> RecordedWrenchSource:
+    """Replays a pull recorded in a CSV file (human.recorded: docs/helpers.md)."""
+    return RecordedWrenchSource(plant, robot, human_config)
+
+
+def write_scripted_recording(
+    scenario: Path | str, path: Path | str, rate_hz: float = PLATE_RATE_HZ
+) -> None:
+    """The scripted pulls of a scenario file (human.pulls, world frame) written to path as
+    a recording: sampled at rate_hz from t = 0 to the scenario's duration_s, as a force
+    plate logs a trial; forces only, to the micronewton (FORCE_DECIMALS). Between its
+    samples the replay interpolates linearly, so a pull whose ramps start and end on the
+    samples replays as scripted (to 1e-6 N)."""
+    loaded = load_scenario(scenario)
+    times = np.arange(round(loaded.duration_s * rate_hz) + 1) / rate_hz
+    forces = np.array([scripted_forces(loaded.human.pulls, t).ravel() for t in times])
+    forces = np.round(forces, FORCE_DECIMALS) + 0.0  # + 0.0: no -0 in the file
+    write_recording(path, times, forces)
