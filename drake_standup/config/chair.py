@@ -96,6 +96,11 @@ class ChairConfig:
     # relative to the current directory; models/chair.sdf is the shipped chair as a
     # file) with a frame 'chair' on the floor below the seat's front edge, x forward.
     file: str = ""
+    # What makes the chair from this section (drake_standup/plugins, docs/extending.md):
+    # standard, the chair of these numbers or of `file`; or a chair of your own, by name or
+    # module:attribute, a function chair(config) -> ChairModel. Its seat height is the
+    # model's: seat_height_m is set from it when the scenario loads.
+    kind: str = "standard"
     # Where the chair's frame (floor, below the seat's front edge) stands. m.
     xyz_m: list[float] = field(default_factory=lambda: [0.16, 0.0, 0.0])
 
@@ -113,3 +118,16 @@ def chair_file(name: str) -> Path:
     shipped one such as models/chair.sdf, else the name as given (config.inputs: missing)."""
     own, shipped = Path(name), data_root() / name
     return shipped if not own.is_absolute() and not own.exists() and shipped.is_file() else own
+
+
+@dataclass(frozen=True)
+class ChairModel:
+    """What a chair plug-in makes of the scenario's chair: section: an SDF model (its text,
+    or a file: relative <uri>s resolve from the file's folder) with one model holding a
+    frame 'chair' on the floor below the seat's front edge, x pointing the way the seated
+    robot faces; and the seat's top above that frame, which the seating and the stand-up
+    plan read. m."""
+
+    seat_height_m: float
+    sdf: str = ""
+    path: Path | None = None

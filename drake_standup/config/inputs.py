@@ -121,7 +121,7 @@ def check_chair_file(name: str) -> Path:
         return path
     read_text_file(path, "chair.file", CHAIR_FILES)
     stat = path.stat()
-    problem = _sdf_problem(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    problem = sdf_problem(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
     if problem:
         raise ScenarioError(f"chair.file: '{name}' {problem}; accepted: {CHAIR_CONTENT}")
     return path
@@ -167,9 +167,10 @@ def add_sdf(parser: Parser, path: Path) -> list[ModelInstanceIndex]:
 
 
 @functools.lru_cache(maxsize=32)
-def _sdf_problem(path: str, mtime_ns: int, size: int) -> str | None:
+def sdf_problem(path: str, mtime_ns: int, size: int) -> str | None:
     """What keeps the SDF file at path from being the chair, or None; cached per file
-    version (mtime_ns, size): a sweep validates every run."""
+    version (mtime_ns, size): a sweep validates every run (and chair_kind.py a chair
+    plug-in's model)."""
     try:
         root = ET.fromstring(Path(path).read_text(encoding="utf-8-sig"))
     except ET.ParseError as err:

@@ -17,8 +17,9 @@ from pathlib import Path
 import yaml
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 
+from drake_standup.config.chair_kind import with_chair_seat
 from drake_standup.config.errors import ScenarioError
-from drake_standup.config.inputs import read_text_file, with_mesh_seat
+from drake_standup.config.inputs import read_text_file
 from drake_standup.config.legacy import read_legacy
 from drake_standup.config.resources import find, shipped
 from drake_standup.config.rules import _format, _nodes, _pattern, validate, with_hardware
@@ -62,8 +63,8 @@ def apply_overrides(scenario: Scenario, overrides: Iterable) -> Scenario:
         top = _set(data, path, value)
         layer[top] = data[top]
     scenario = validate(with_hardware(_load(layer, scenario)))
-    # A mesh chair's seat height is the mesh's (config/inputs.py with_mesh_seat).
-    return dataclasses.replace(scenario, chair=with_mesh_seat(scenario.chair))
+    # The chair's seat height is the made chair's (a mesh's, a plug-in's: chair_kind.py).
+    return dataclasses.replace(scenario, chair=with_chair_seat(scenario.chair))
 
 
 def expand_key_path(scenario: Scenario, path: str) -> list[str]:

@@ -1,5 +1,5 @@
-"""The registry of plug-ins: advancement laws and helpers, by name (chairs and responses
-are to follow, issue 61). The public face is drake_standup.plugins.
+"""The registry of plug-ins: advancement laws, helpers and chairs, by name (responses are
+to follow, issue 61). The public face is drake_standup.plugins.
 
 A scenario names a plug-in three ways, tried in this order:
 
@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.metadata
+import inspect
 import os
 import sys
 from dataclasses import dataclass
@@ -31,7 +32,7 @@ from typing import Any
 from drake_standup.config.errors import ScenarioError
 
 # Each kind of plug-in and the scenario key that names one.
-KINDS = {"laws": "advancement.law", "helpers": "human.mode"}
+KINDS = {"laws": "advancement.law", "helpers": "human.mode", "chairs": "chair.kind"}
 ENTRY_POINT_GROUP = "drake_standup.{kind}"
 # The shipped plug-ins, by kind and name, and each kind's check of an object (what is wrong
 # with it as one, or None), each as module:attribute.
@@ -46,10 +47,12 @@ SHIPPED = {
         "body": "drake_standup.helper.body_control:body_helper",
         "recorded": "drake_standup.helper.recorded:make_recorded_helper",
     },
+    "chairs": {"standard": "drake_standup.world.chair:standard_chair"},
 }
 CHECKS = {
     "laws": "drake_standup.standup.laws:check_law",
     "helpers": "drake_standup.helper.plugin:check_helper",
+    "chairs": "drake_standup.config.plugins:check_one_argument",
 }
 # Their descriptions where the object's docstring does not fit `drake-standup list`.
 _DESCRIPTIONS = {
@@ -189,6 +192,19 @@ def _origin_of(obj: Any) -> str:
 def _first_line(obj: Any) -> str:
     doc = (getattr(obj, "__doc__", None) or "").strip()
     return " ".join(doc.split("\n\n")[0].split())  # its first paragraph, on one line
+
+
+def check_one_argument(obj: Any) -> str | None:
+    """What is wrong with obj as a chair maker, chair(config) -> ChairModel (None: nothing)."""
+    if not callable(obj):
+        return f"is a {type(obj).__name__}, not callable; accepted: chair(config) -> ChairModel"
+    try:
+        inspect.signature(obj).bind(None)
+    except TypeError:
+        return f"cannot be called as chair(config): its signature is {inspect.signature(obj)}"
+    except ValueError:
+        return None
+    return None
 
 
 def _check_kind(kind: str) -> None:

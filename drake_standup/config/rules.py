@@ -258,10 +258,12 @@ def validate(scenario: Scenario) -> Scenario:
 def _check_plugins(scenario: Scenario) -> None:
     """advancement.law and human.mode name plug-ins that import and fit their interface
     (drake_standup/plugins: a registered name, module:attribute or an entry point)."""
+    from drake_standup.config.chair_kind import make_chair
     from drake_standup.config.plugins import resolve
 
     resolve("laws", scenario.advancement.law)
     resolve("helpers", scenario.human.mode)
+    make_chair(scenario.chair)
 
 
 def _check_rules(data: dict) -> None:

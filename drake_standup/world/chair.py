@@ -18,8 +18,9 @@ import os
 import tempfile
 from pathlib import Path
 
-from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig
-from drake_standup.config.chair_mesh import ChairMesh, obj_text
+from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig, ChairModel, chair_file
+from drake_standup.config.chair_mesh import ChairMesh, is_mesh, obj_text
+from drake_standup.config.inputs import chair_mesh
 
 # The shipped chair's look (models/chair.sdf): seat 0.40 m deep, 0.44 m wide; legs
 # 0.04 m square, inset 0.03 m; a backrest 0.03 m thick from 0.02 m above the seat. m.
@@ -131,3 +132,14 @@ def cached_obj(mesh: ChairMesh) -> Path:
             f.write(text)
         os.replace(part, path)
     return path
+
+
+def standard_chair(config: ChairConfig) -> ChairModel:
+    """The chair of the scenario's numbers, or of chair.file: an SDF, or a mesh whose seat
+    is found in it (config/chair_mesh.py)."""
+    if not config.file:
+        return ChairModel(config.seat_height_m, sdf=chair_sdf(config))
+    if is_mesh(config.file):
+        mesh = chair_mesh(config.file)
+        return ChairModel(mesh.seat.height_m, sdf=mesh_chair_sdf(config, mesh))
+    return ChairModel(config.seat_height_m, path=chair_file(config.file))

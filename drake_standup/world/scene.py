@@ -10,6 +10,7 @@ import dataclasses
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet, SceneGraph
@@ -19,15 +20,14 @@ from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import Context, DiagramBuilder
 
-from drake_standup.config import ChairConfig, Scenario, ScenarioError, chair_file
-from drake_standup.config.chair_mesh import is_mesh
-from drake_standup.config.inputs import add_sdf, chair_mesh
+from drake_standup.config import ChairConfig, Scenario, ScenarioError
+from drake_standup.config.chair_kind import make_chair
+from drake_standup.config.inputs import add_sdf
 from drake_standup.config.phases import PHASES
 from drake_standup.config.resources import model_file
 from drake_standup.helper.body import GRIPS, HelperBody, add_helper_body
 from drake_standup.robot.icub import Robot, add_icub, reflects_motor_inertia, set_joint_positions
 from drake_standup.robot.last_com import LastCoM
-from drake_standup.world.chair import chair_sdf, mesh_chair_sdf
 from drake_standup.world.perturbations import scale_friction
 from drake_standup.world.seating import SeatedPose, seated_pose
 
@@ -199,21 +199,20 @@ def add_scene(
 
 
 def _add_chair(parser: Parser, chair: ChairConfig) -> ModelInstanceIndex:
-    """The chair's model, with a frame 'chair' (config.validate checked a user's file): the
-    one of chair's numbers, a user's SDF file, or a mesh whose seat height chair has."""
-    if not chair.file:
-        (model,) = parser.AddModelsFromString(chair_sdf(chair), "sdf")
-    elif is_mesh(chair.file):
-        mesh = chair_mesh(chair.file)
-        if abs(chair.seat_height_m - mesh.seat.height_m) > 5e-4:
-            raise ScenarioError(
-                f"chair.seat_height_m: {chair.seat_height_m:g}; accepted: "
-                f"{mesh.seat.height_m:.4f}, the seat of chair.file '{chair.file}' (a mesh: "
-                "load_scenario sets it so)"
-            )
-        (model,) = parser.AddModelsFromString(mesh_chair_sdf(chair, mesh), "sdf")
+    """The chair chair.kind makes (config/chair_kind.py; standard: the one of chair's numbers,
+    a user's SDF file, or a mesh), with a frame 'chair'. Its seat is where the scenario
+    says: load_scenario set seat_height_m from the made chair; one made in code is checked."""
+    made = make_chair(chair)
+    if abs(chair.seat_height_m - made.seat_height_m) > 5e-4:
+        raise ScenarioError(
+            f"chair.seat_height_m: {chair.seat_height_m:g}; accepted: "
+            f"{made.seat_height_m:.4f}, the seat of the chair chair.kind '{chair.kind}' makes "
+            "(load_scenario sets it so)"
+        )
+    if made.path is not None:
+        (model,) = add_sdf(parser, Path(made.path))
     else:
-        (model,) = add_sdf(parser, chair_file(chair.file))
+        (model,) = parser.AddModelsFromString(made.sdf, "sdf")
     return model
 
 

@@ -210,3 +210,38 @@ def test_a_law_outside_the_package_runs_as_the_same_law_inside_it():
     plain = _metrics("advancement.enabled=false")
     assert constant["success"]
     assert shipped["standup_time_s"] < constant["standup_time_s"] < plain["standup_time_s"]
+
+
+def _chair_scenario(kind: str):
+    return load_scenario(SCENARIO_DIR / "assisted.yaml", [("chair.kind", kind)])
+
+
+def test_a_chair_plugin_sets_the_seat_height_the_plan_reads():
+    assert _chair_scenario("lab_chairs:tall_stool").chair.seat_height_m == 0.25
+    assert _chair_scenario("lab_chairs:box_again").chair.seat_height_m == 0.2195
+
+
+@pytest.mark.parametrize(
+    ("kind", "says"),
+    [
+        ("lab_chairs:not_a_model", "made a str; accepted: ChairModel"),
+        ("lab_chairs:floating_seat", "made a seat 2.0 m high"),
+        ("lab_chairs:no_chair_frame", "has no frame named 'chair'"),
+        ("lab_laws:two_arguments", "cannot be called as chair(config)"),
+        ("no_such_chair", "is not a known name; accepted: standard"),
+    ],
+)
+def test_a_bad_chair_is_one_line_naming_the_key(kind, says):
+    with pytest.raises(PluginError) as err:
+        _chair_scenario(kind)
+    text = str(err.value)
+    assert text.startswith("chair.kind: ") and says in text and "\n" not in text
+
+
+@pytest.mark.slow
+def test_the_box_chair_made_by_a_plugin_is_the_shipped_chair():
+    """The standard chair and the same chair made outside the package: the same run."""
+    shipped = _metrics()
+    outside = _metrics("chair.kind=lab_chairs:box_again")
+    for key in ("standup_time_s", "psi_final", "sole_force_chatter_N", "com_tracking_rms_m"):
+        assert outside[key] == shipped[key], key
