@@ -242,6 +242,10 @@ def missing_names(
 # Heads of dotted names in a doc that are not the package's: libraries, the scenario's
 # subsections (human.reactive, phases.*.exit).
 _FOREIGN = {"numpy", "np", "json", "icub_models", "importlib", "pyproject", "pydrake"}
+# A user's own package in docs/extending.md's walk-through, and a plug-in class's self.
+_FOREIGN |= {"mylab", "self"}
+# The plug-ins' entry point groups (config/plugins.py ENTRY_POINT_GROUP): names, no modules.
+_ENTRY_POINT_GROUPS = {"drake_standup.laws", "drake_standup.helpers", "drake_standup.chairs"}
 _SUBSECTIONS = {"reactive", "exit", "body", "pulls", "advance", "seated", "forward"}
 _DOTTED = re.compile(r"(?<![\w.])([a-z_][a-z0-9_]*(?:\.[A-Za-z_]\w*)+)")
 
@@ -256,6 +260,8 @@ def _unresolved_dotted(text: str, modules: dict[str, Path]) -> list[str]:
     for dotted in _DOTTED.findall(text):
         head, *rest = dotted.split(".")
         if rest and rest[0] in _SUFFIXES:
+            continue
+        if dotted in _ENTRY_POINT_GROUPS:
             continue
         if head == "drake_standup":
             path = PACKAGE

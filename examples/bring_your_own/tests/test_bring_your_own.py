@@ -86,3 +86,23 @@ def test_the_swaying_helper_stands_the_robot_up():
     metrics = _run("human.mode=sway", "advancement.law=gated")
     assert metrics["success"], metrics["failure_reason"]
     assert np.isfinite(metrics["standup_time_s"])
+
+
+@pytest.mark.slow
+def test_the_lab_chair_and_the_recorded_pull_stand_the_robot_up_sooner():
+    """The lab's mesh chair (its 0.23 m seat read from the mesh) and its recorded pull,
+    replayed, with the example's law: it stands up, sooner than with psi = t."""
+    from bring_your_own import LAB_CHAIR, LAB_PULL
+
+    lab = (
+        f"chair.file={LAB_CHAIR}",
+        "human.mode=recorded",
+        f"human.recorded.file={LAB_PULL}",
+        "advancement.law=gated",
+    )
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml", [parse_set(o) for o in lab])
+    assert scenario.chair.seat_height_m == pytest.approx(0.23)
+    helped = _run(*lab)
+    plain = _run(*lab, "advancement.enabled=false")
+    assert helped["success"] and plain["success"]
+    assert helped["standup_time_s"] < plain["standup_time_s"] - 0.3
