@@ -245,3 +245,47 @@ def test_the_box_chair_made_by_a_plugin_is_the_shipped_chair():
     outside = _metrics("chair.kind=lab_chairs:box_again")
     for key in ("standup_time_s", "psi_final", "sole_force_chatter_N", "com_tracking_rms_m"):
         assert outside[key] == shipped[key], key
+
+
+def _helper_output(mode: str, t: float):
+    """The helper mode builds, in its own context at time t: (hand_wrenches_W, the applied
+    spatial forces)."""
+    from drake_standup.sim.diagram import build_diagram
+
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml", [("human.mode", mode)])
+    built = build_diagram(scenario)
+    human = built.diagram.GetSubsystemByName("human")
+    context = human.CreateDefaultContext()
+    context.SetTime(t)
+    nx = human.get_input_port(0).size()
+    human.GetInputPort("robot_state").FixValue(context, np.zeros(nx))
+    wrenches = human.GetOutputPort("hand_wrenches_W").Eval(context)
+    forces = human.GetOutputPort("spatial_forces").Eval(context)
+    return wrenches, forces
+
+
+def test_a_helper_plugin_pulls_the_hands_it_says():
+    """docs/extending.md's helper: nothing before 3 s, 15 N forward and up on each hand
+    after, as wrenches and as the plant's applied forces (at the hand frames)."""
+    before, applied = _helper_output("lab_helpers:Steady", 2.0)
+    assert not np.any(before) and applied == []
+    after, applied = _helper_output("lab_helpers:Steady", 4.0)
+    expected = np.zeros(12)
+    expected[[3, 5, 9, 11]] = 15.0
+    np.testing.assert_array_equal(after, expected)
+    assert len(applied) == 2
+    np.testing.assert_array_equal(applied[0].F_Bq_W.translational(), [15.0, 0.0, 15.0])
+
+
+def test_a_helper_plugin_torque_reaches_the_plant():
+    wrenches, applied = _helper_output("lab_helpers:Twisting", 2.0)
+    assert len(applied) == 1
+    np.testing.assert_array_equal(applied[0].F_Bq_W.rotational(), [0.0, 0.0, 2.0])
+    np.testing.assert_array_equal(wrenches[:3], [0.0, 0.0, 2.0])
+
+
+def test_a_helper_without_the_ports_or_the_shape_is_one_line():
+    with pytest.raises(PluginError, match=r"^human.mode: 'lab_helpers:portless' built a system"):
+        _helper_output("lab_helpers:portless", 0.0)
+    with pytest.raises(PluginError, match=r"gave shape \(6,\) at t = 0.000 s; accepted: \(12,\)"):
+        _helper_output("lab_helpers:WrongShape", 0.0)

@@ -106,3 +106,52 @@ def test_the_lab_chair_and_the_recorded_pull_stand_the_robot_up_sooner():
     plain = _run(*lab, "advancement.enabled=false")
     assert helped["success"] and plain["success"]
     assert helped["standup_time_s"] < plain["standup_time_s"] - 0.3
+
+
+def _cli(*args, cwd):
+    return subprocess.run(
+        [sys.executable, "-m", "drake_standup", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=900,
+    )
+
+
+@pytest.mark.slow
+def test_a_sweep_on_two_dask_workers_runs_the_law_by_both_names(tmp_path):
+    """The law by entry point and by module:attribute on two worker processes: the same
+    stand-up, psi and chatter in results.csv."""
+    import csv
+
+    sweep = tmp_path / "laws.yaml"
+    sweep.write_text(
+        "name: laws\nbase: assisted\nseed: 1\noverrides:\n  duration_s: 6.0\n"
+        "grid:\n  - name: law\n    path: advancement.law\n"
+        '    values: [gated, "bring_your_own.laws:gated_law"]\n'
+    )
+    done = _cli("sweep", str(sweep), "--workers", "2", "--out", str(tmp_path / "out"), cwd=tmp_path)
+    assert done.returncode == 0, done.stderr[-2000:]
+    with open(tmp_path / "out" / "results.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["law"] for r in rows] == ["gated", "bring_your_own.laws:gated_law"]
+    assert rows[0]["success"] == rows[1]["success"] == "True"
+    for key in ("standup_time_s", "psi_final", "sole_force_chatter_N"):
+        assert rows[0][key] == rows[1][key]
+
+
+@pytest.mark.slow
+def test_compare_runs_the_law_against_stiff(tmp_path):
+    """drake-standup compare with the example's law: advancement stands up sooner than
+    stiff under the default pull."""
+    import csv
+
+    out = tmp_path / "cmp"
+    done = _cli(
+        "compare", "--helpers", "assisted", "--responses", "advancement", "stiff",
+        "--set", "advancement.law=gated", "--workers", "2", "--out", str(out), cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    with open(out / "results.csv") as f:
+        times = {r["response"]: float(r["standup_time_s"]) for r in csv.DictReader(f)}
+    assert times["advancement"] < times["stiff"] - 0.3
