@@ -10,6 +10,8 @@ The wrench acts at the origin of the hand task frame (the hand's DH frame).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from pydrake.common.value import Value
 from pydrake.multibody.math import SpatialForce
@@ -54,6 +56,48 @@ def spatial_forces(
             force.F_Bq_W = SpatialForce(np.zeros(3), f)
             pulled.append(force)
     return pulled
+
+
+def applied_wrenches(
+    applied: list[ExternallyAppliedSpatialForce], hand_wrenches_W: np.ndarray
+) -> list[ExternallyAppliedSpatialForce]:
+    """applied (hand_forces) set to hand_wrenches_W's torques and forces, the hands whose
+    wrench is not zero only (a recorded or a plug-in helper's, which may twist the hands)."""
+    pulled = []
+    for force, wrench in zip(applied, hand_wrenches_W.reshape(2, 6)):
+        if np.count_nonzero(wrench):
+            force.F_Bq_W = SpatialForce(wrench[:3], wrench[3:])
+            pulled.append(force)
+    return pulled
+
+
+def declare_hand_outputs(
+    system: LeafSystem,
+    calc: Callable[[Context], np.ndarray],
+    prerequisites: set,
+    applied: list[ExternallyAppliedSpatialForce],
+    to_forces: Callable = spatial_forces,
+):
+    """A helper's two outputs, hand_wrenches_W (12) and spatial_forces (to_forces of
+    applied and those wrenches), from one evaluation of calc(context) per change of
+    prerequisites. Returns the cache entry of calc's wrenches."""
+    cache = declare_cached(system, "hand wrenches", calc, prerequisites)
+    ticket = {cache.ticket()}
+
+    def wrenches(context: Context, output: BasicVector) -> None:
+        output.SetFromVector(cache.Eval(context))
+
+    def forces(context: Context, output) -> None:
+        output.set_value(to_forces(applied, cache.Eval(context)))
+
+    system.DeclareVectorOutputPort("hand_wrenches_W", 12, wrenches, prerequisites_of_calc=ticket)
+    system.DeclareAbstractOutputPort(
+        "spatial_forces",
+        lambda: Value[list[ExternallyAppliedSpatialForce]]([]),
+        forces,
+        prerequisites_of_calc=ticket,
+    )
+    return cache
 
 
 def scripted_forces(pulls: list[Pull], t: float) -> np.ndarray:
@@ -126,19 +170,8 @@ class HumanWrenchSource(LeafSystem):
             )
             for pull in (config.pulls if config.mode == "scripted" else [])
         ]
-        # Both outputs read one evaluation of the human per time (and state):
-        # hand_wrenches_W itself, (12,).
-        self._wrenches_cache = declare_cached(self, "hand wrenches", self._wrenches, prereq)
-        prereq = {self._wrenches_cache.ticket()}
-        self.DeclareVectorOutputPort(
-            "hand_wrenches_W", 12, self._CalcWrenches, prerequisites_of_calc=prereq
-        )
-        self.DeclareAbstractOutputPort(
-            "spatial_forces",
-            lambda: Value[list[ExternallyAppliedSpatialForce]]([]),
-            self._CalcSpatialForces,
-            prerequisites_of_calc=prereq,
-        )
+        # Both outputs read one evaluation of the human per time (and state).
+        declare_hand_outputs(self, self._wrenches, prereq, self._applied)
 
     def _hands(self, context: Context) -> tuple[list[np.ndarray], list[np.ndarray]]:
         """World positions and velocities of the hand frames' origins."""
@@ -218,9 +251,3 @@ class HumanWrenchSource(LeafSystem):
                 wrenches[rows] += scale * force
         self._last_scripted = t, wrenches
         return wrenches
-
-    def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
-        output.SetFromVector(self._wrenches_cache.Eval(context))
-
-    def _CalcSpatialForces(self, context: Context, output) -> None:
-        output.set_value(spatial_forces(self._applied, self._wrenches_cache.Eval(context)))

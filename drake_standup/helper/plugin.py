@@ -20,15 +20,12 @@ import inspect
 from typing import Any
 
 import numpy as np
-from pydrake.common.value import Value
-from pydrake.multibody.math import SpatialForce
-from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
-from pydrake.systems.framework import BasicVector, Context, LeafSystem, System
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import Context, LeafSystem, System
 
 from drake_standup.config import HumanConfig
 from drake_standup.config.plugins import PluginError
-from drake_standup.helper.hands import hand_forces
-from drake_standup.ports.caching import declare_cached
+from drake_standup.helper.hands import applied_wrenches, declare_hand_outputs, hand_forces
 from drake_standup.robot.icub import Robot
 
 PORTS = {"input": ("robot_state",), "output": ("hand_wrenches_W", "spatial_forces")}
@@ -45,17 +42,7 @@ class HandWrenchHelper(LeafSystem):
         nx = plant.num_multibody_states(robot.model_instance)
         self._state = self.DeclareVectorInputPort("robot_state", nx)
         prereq = {self.time_ticket(), self._state.ticket()}
-        self._cache = declare_cached(self, "hand wrenches", self._evaluate, prereq)
-        prereq = {self._cache.ticket()}
-        self.DeclareVectorOutputPort(
-            "hand_wrenches_W", 12, self._CalcWrenches, prerequisites_of_calc=prereq
-        )
-        self.DeclareAbstractOutputPort(
-            "spatial_forces",
-            lambda: Value[list[ExternallyAppliedSpatialForce]]([]),
-            self._CalcSpatialForces,
-            prerequisites_of_calc=prereq,
-        )
+        declare_hand_outputs(self, self._evaluate, prereq, self._applied, applied_wrenches)
 
     def hand_wrenches(self, time_s: float, robot_state: np.ndarray) -> np.ndarray:
         """The wrenches on the hands now (module docstring); a subclass gives them."""
@@ -76,25 +63,6 @@ class HandWrenchHelper(LeafSystem):
                 f"t = {t:.3f} s; accepted: finite N m and N"
             )
         return wrenches.reshape(12)
-
-    def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
-        output.SetFromVector(self._cache.Eval(context))
-
-    def _CalcSpatialForces(self, context: Context, output) -> None:
-        output.set_value(wrench_forces(self._applied, self._cache.Eval(context)))
-
-
-def wrench_forces(
-    applied: list[ExternallyAppliedSpatialForce], hand_wrenches_W: np.ndarray
-) -> list[ExternallyAppliedSpatialForce]:
-    """applied (hands.hand_forces) set to hand_wrenches_W's torques and forces, the hands
-    with a nonzero wrench only."""
-    pulled = []
-    for force, w in zip(applied, (hand_wrenches_W[:6], hand_wrenches_W[6:])):
-        if np.count_nonzero(w):
-            force.F_Bq_W = SpatialForce(w[:3], w[3:])
-            pulled.append(force)
-    return pulled
 
 
 def check_helper(obj: Any) -> str | None:

@@ -18,15 +18,18 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from pydrake.common.value import Value
-from pydrake.multibody.math import SpatialForce
-from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
-from pydrake.systems.framework import BasicVector, Context, LeafSystem
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import Context, LeafSystem
 
 from drake_standup.config import HumanConfig, load_scenario
 from drake_standup.config.recording import load_recording, write_recording
-from drake_standup.helper.hands import TASK_FRAMES, hand_forces, scripted_forces
-from drake_standup.ports.caching import declare_cached
+from drake_standup.helper.hands import (
+    TASK_FRAMES,
+    applied_wrenches,
+    declare_hand_outputs,
+    hand_forces,
+    scripted_forces,
+)
 from drake_standup.robot.icub import Robot
 
 # A force plate's rate: the shipped recording's samples. Hz.
@@ -35,19 +38,6 @@ PLATE_RATE_HZ = 1000.0
 # a force plate's resolution, and a ramp's samples read as the decimals they are (0.03 N
 # a millisecond on the default pull's, not 0.029999999999996696).
 FORCE_DECIMALS = 6
-
-
-def applied_wrenches(
-    applied: list[ExternallyAppliedSpatialForce], hand_wrenches_W: np.ndarray
-) -> list[ExternallyAppliedSpatialForce]:
-    """applied (hand_forces) set to hand_wrenches_W's torques and forces, the hands
-    whose wrench is not zero only (none: the plant then has nothing to apply)."""
-    pulled = []
-    for force, wrench in zip(applied, hand_wrenches_W.reshape(2, 6)):
-        if np.count_nonzero(wrench):
-            force.F_Bq_W = SpatialForce(wrench[:3], wrench[3:])
-            pulled.append(force)
-    return pulled
 
 
 class RecordedWrenchSource(LeafSystem):
@@ -72,17 +62,7 @@ class RecordedWrenchSource(LeafSystem):
         # In the world frame the wrenches are a function of time alone: the last time and
         # its wrenches (the integrator sets a step's end time twice, a change to Drake).
         self._last: tuple[float, np.ndarray] | None = None
-        self._wrenches_cache = declare_cached(self, "hand wrenches", self._wrenches, prereq)
-        prereq = {self._wrenches_cache.ticket()}
-        self.DeclareVectorOutputPort(
-            "hand_wrenches_W", 12, self._CalcWrenches, prerequisites_of_calc=prereq
-        )
-        self.DeclareAbstractOutputPort(
-            "spatial_forces",
-            lambda: Value[list[ExternallyAppliedSpatialForce]]([]),
-            self._CalcSpatialForces,
-            prerequisites_of_calc=prereq,
-        )
+        declare_hand_outputs(self, self._wrenches, prereq, self._applied, applied_wrenches)
 
     def sampled(self, t: float) -> np.ndarray:
         """(12,) the recording at time t in its own frame: each column interpolated
@@ -112,12 +92,6 @@ class RecordedWrenchSource(LeafSystem):
             for part in (slice(6 * i, 6 * i + 3), slice(6 * i + 3, 6 * i + 6)):
                 wrenches[part] = R_WH @ wrenches_H[part]
         return wrenches
-
-    def _CalcWrenches(self, context: Context, output: BasicVector) -> None:
-        output.SetFromVector(self._wrenches_cache.Eval(context))
-
-    def _CalcSpatialForces(self, context: Context, output) -> None:
-        output.set_value(applied_wrenches(self._applied, self._wrenches_cache.Eval(context)))
 
 
 def make_recorded_helper(
