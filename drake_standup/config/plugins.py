@@ -52,7 +52,7 @@ SHIPPED = {
 CHECKS = {
     "laws": "drake_standup.standup.laws:check_law",
     "helpers": "drake_standup.helper.plugin:check_helper",
-    "chairs": "drake_standup.config.plugins:check_one_argument",
+    "chairs": "drake_standup.config.plugins:check_chair",
 }
 # Their descriptions where the object's docstring does not fit `drake-standup list`.
 _DESCRIPTIONS = {
@@ -194,17 +194,25 @@ def _first_line(obj: Any) -> str:
     return " ".join(doc.split("\n\n")[0].split())  # its first paragraph, on one line
 
 
-def check_one_argument(obj: Any) -> str | None:
-    """What is wrong with obj as a chair maker, chair(config) -> ChairModel (None: nothing)."""
+def call_problem(obj: Any, arguments: int, usage: str) -> str | None:
+    """What keeps obj from being called as usage with `arguments` positional arguments
+    (None: nothing; an object whose signature cannot be read is tried at its first call)."""
     if not callable(obj):
-        return f"is a {type(obj).__name__}, not callable; accepted: chair(config) -> ChairModel"
+        return f"is a {type(obj).__name__}, not callable; accepted: {usage}"
     try:
-        inspect.signature(obj).bind(None)
-    except TypeError:
-        return f"cannot be called as chair(config): its signature is {inspect.signature(obj)}"
-    except ValueError:
+        signature = inspect.signature(obj)
+    except (TypeError, ValueError):
         return None
+    try:
+        signature.bind(*(None,) * arguments)
+    except TypeError:
+        return f"has the signature {signature}; accepted: {usage}"
     return None
+
+
+def check_chair(obj: Any) -> str | None:
+    """What is wrong with obj as a chair maker (None: nothing)."""
+    return call_problem(obj, 1, "chair(config) -> ChairModel")
 
 
 def _check_kind(kind: str) -> None:

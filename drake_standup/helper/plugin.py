@@ -16,7 +16,6 @@ and the live page's intent (the shipped `body`, helper/body_control.py).
 
 from __future__ import annotations
 
-import inspect
 from typing import Any
 
 import numpy as np
@@ -24,7 +23,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Context, LeafSystem, System
 
 from drake_standup.config import HumanConfig
-from drake_standup.config.plugins import PluginError
+from drake_standup.config.plugins import PluginError, call_problem
 from drake_standup.helper.hands import applied_wrenches, declare_hand_outputs, hand_forces
 from drake_standup.robot.icub import Robot
 
@@ -67,23 +66,9 @@ class HandWrenchHelper(LeafSystem):
 
 def check_helper(obj: Any) -> str | None:
     """What is wrong with obj as a helper factory (None: nothing)."""
-    if not callable(obj):
-        return f"is a {type(obj).__name__}, not callable; accepted: helper(plant, robot, config)"
-    arguments = (None,) * (5 if getattr(obj, "adds_body", False) else 3)
-    try:
-        inspect.signature(obj).bind(*arguments)
-    except TypeError:
-        return f"cannot be called as helper(plant, robot, config){_signature(obj)}"
-    except ValueError:
-        return None
-    return None
-
-
-def _signature(obj: Any) -> str:
-    try:
-        return f": its signature is {inspect.signature(obj)}"
-    except (TypeError, ValueError):
-        return ""
+    if getattr(obj, "adds_body", False):
+        return call_problem(obj, 5, "helper(plant, robot, config, person, intent) -> System")
+    return call_problem(obj, 3, "helper(plant, robot, config) -> System")
 
 
 def check_helper_ports(system: System, spec: str) -> None:

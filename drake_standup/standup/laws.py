@@ -51,7 +51,6 @@ ends the run with one `error:` line naming the law.
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import math
 from collections.abc import Callable
 from typing import Any
@@ -59,7 +58,7 @@ from typing import Any
 import numpy as np
 
 from drake_standup.config import AdvancementConfig
-from drake_standup.config.plugins import PluginError
+from drake_standup.config.plugins import PluginError, call_problem
 from drake_standup.control.smooth import smoothstep
 from drake_standup.standup.com_path import leaned
 
@@ -265,25 +264,7 @@ def _gated(inputs: LawInputs, ratio_of: Callable) -> float:
 
 def check_law(obj: Any) -> str | None:
     """What is wrong with obj as a law (None: nothing): callable with one argument."""
-    if not callable(obj):
-        return f"is a {type(obj).__name__}, not callable; accepted: a function law(inputs) -> float"
-    try:
-        inspect.signature(obj).bind(None)
-    except TypeError:
-        return (
-            f"has the signature {_signature(obj)}; accepted: one argument, law(inputs) -> float "
-            "(inputs: drake_standup.plugins.LawInputs)"
-        )
-    except ValueError:  # no signature to read (a builtin): tried at its first call
-        return None
-    return None
-
-
-def _signature(obj: Any) -> str:
-    try:
-        return str(inspect.signature(obj))
-    except (TypeError, ValueError):
-        return "(?)"
+    return call_problem(obj, 1, "law(inputs) -> float, inputs a drake_standup.plugins.LawInputs")
 
 
 def checked_rate(value: Any, spec: str, time_s: float) -> float:

@@ -72,7 +72,7 @@ def test_an_entry_point_resolves(monkeypatch):
         ("no_such_law", "is not a known name; accepted: tangent | interaction"),
         ("no_such_module_xyz:law", "module 'no_such_module_xyz' does not import"),
         ("lab_laws:missing", "'lab_laws' has no attribute 'missing'"),
-        ("lab_laws:two_arguments", "has the signature (inputs, other); accepted: one argument"),
+        ("lab_laws:two_arguments", "has the signature (inputs, other); accepted: law(inputs)"),
         ("lab_laws:NOT_CALLABLE", "is a float, not callable"),
         ("lab_laws", "is not a known name"),
     ],
@@ -85,7 +85,7 @@ def test_a_bad_law_is_one_line_naming_the_key(spec, says):
 
 
 def test_a_bad_helper_is_one_line_naming_the_key():
-    with pytest.raises(PluginError, match=r"^human.mode: 'lab_laws:two_arguments' cannot be"):
+    with pytest.raises(PluginError, match=r"^human.mode: 'lab_laws:two_arguments' has the sig"):
         resolve("helpers", "lab_laws:two_arguments")
 
 
@@ -227,7 +227,7 @@ def test_a_chair_plugin_sets_the_seat_height_the_plan_reads():
         ("lab_chairs:not_a_model", "made a str; accepted: ChairModel"),
         ("lab_chairs:floating_seat", "made a seat 2.0 m high"),
         ("lab_chairs:no_chair_frame", "has no frame named 'chair'"),
-        ("lab_laws:two_arguments", "cannot be called as chair(config)"),
+        ("lab_laws:two_arguments", "accepted: chair(config) -> ChairModel"),
         ("no_such_chair", "is not a known name; accepted: standard"),
     ],
 )
