@@ -245,7 +245,12 @@ _FOREIGN = {"numpy", "np", "json", "icub_models", "importlib", "pyproject", "pyd
 # A user's own package in docs/extending.md's walk-through, and a plug-in class's self.
 _FOREIGN |= {"mylab", "self"}
 # The plug-ins' entry point groups (config/plugins.py ENTRY_POINT_GROUP): names, no modules.
-_ENTRY_POINT_GROUPS = {"drake_standup.laws", "drake_standup.helpers", "drake_standup.chairs"}
+_ENTRY_POINT_GROUPS = {
+    "drake_standup.laws",
+    "drake_standup.helpers",
+    "drake_standup.chairs",
+    "drake_standup.responses",
+}
 _SUBSECTIONS = {"reactive", "exit", "body", "pulls", "advance", "seated", "forward"}
 _DOTTED = re.compile(r"(?<![\w.])([a-z_][a-z0-9_]*(?:\.[A-Za-z_]\w*)+)")
 

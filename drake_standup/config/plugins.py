@@ -1,5 +1,5 @@
-"""The registry of plug-ins: advancement laws, helpers and chairs, by name (responses are
-to follow, issue 61). The public face is drake_standup.plugins.
+"""The registry of plug-ins: advancement laws, helpers, chairs and responses, by name. The
+public face is drake_standup.plugins.
 
 A scenario names a plug-in three ways, tried in this order:
 
@@ -32,7 +32,12 @@ from typing import Any
 from drake_standup.config.errors import ScenarioError
 
 # Each kind of plug-in and the scenario key that names one.
-KINDS = {"laws": "advancement.law", "helpers": "human.mode", "chairs": "chair.kind"}
+KINDS = {
+    "laws": "advancement.law",
+    "helpers": "human.mode",
+    "chairs": "chair.kind",
+    "responses": "response",
+}
 ENTRY_POINT_GROUP = "drake_standup.{kind}"
 # The shipped plug-ins, by kind and name, and each kind's check of an object (what is wrong
 # with it as one, or None), each as module:attribute.
@@ -48,14 +53,23 @@ SHIPPED = {
         "recorded": "drake_standup.helper.recorded:make_recorded_helper",
     },
     "chairs": {"standard": "drake_standup.world.chair:standard_chair"},
+    "responses": {
+        "advancement": "drake_standup.config.responses:ADVANCEMENT",
+        "stiff": "drake_standup.config.responses:STIFF",
+        "compliant": "drake_standup.config.responses:COMPLIANT",
+    },
 }
 CHECKS = {
     "laws": "drake_standup.standup.laws:check_law",
     "helpers": "drake_standup.helper.plugin:check_helper",
     "chairs": "drake_standup.config.plugins:check_chair",
+    "responses": "drake_standup.config.responses:check_response",
 }
 # Their descriptions where the object's docstring does not fit `drake-standup list`.
 _DESCRIPTIONS = {
+    ("responses", "advancement"): "psi runs ahead of time while the pull helps (the paper's)",
+    ("responses", "stiff"): "psi = t, the pull compensated in full",
+    ("responses", "compliant"): "psi = t, the CoM reference yielding to the pull",
     ("helpers", "scripted"): "the scenario's pulls, trapezoids in time",
     ("helpers", "reactive"): "a partner guiding each hand from what they saw of the robot, "
     "late, through an arm's impedance",

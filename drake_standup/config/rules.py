@@ -24,7 +24,7 @@ from drake_standup.config.hardware import HARDWARE
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
 from drake_standup.config.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
 from drake_standup.config.recording import FRAMES, load_recording
-from drake_standup.config.scenario import REFLECTED_INERTIA, RESPONSES, Scenario
+from drake_standup.config.scenario import REFLECTED_INERTIA, Scenario
 
 
 @dataclass(frozen=True)
@@ -82,7 +82,6 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (Range(low=1.0, high=3.0, text="1, 2 or 3", integer=True), "hardware.delay_ticks"),
     (Range(low=0.0, high=5.0), "hardware.*_scale"),
     (PLANT_STEP, "hardware.plant_time_step_s"),
-    (RESPONSES, "response"),
     (("hands", "time"), "standup.trigger"),
     (SEAT_HOLDS, "phases.*.seat_hold phases.*.seat_hold_sat_back"),
     (SEAT_PADS, "phases.*.unload[*]"),
@@ -263,6 +262,7 @@ def _check_plugins(scenario: Scenario) -> None:
 
     resolve("laws", scenario.advancement.law)
     resolve("helpers", scenario.human.mode)
+    resolve("responses", scenario.response)
     make_chair(scenario.chair)
 
 

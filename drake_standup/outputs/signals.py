@@ -84,7 +84,7 @@ def make_signals(built, root_context) -> dict[str, np.ndarray]:
     signals = _station_signals(built.station, logs)
     if "controller_diagnostics" not in logs:  # the seat-hold benchmark: no controller
         return signals
-    signals |= _controller_signals(logs)
+    signals |= _controller_signals(logs, getattr(built, "responses", RESPONSES))
     return signals
 
 
@@ -194,13 +194,15 @@ def _helper_body_signals(station, logs: dict[str, np.ndarray]) -> dict[str, np.n
     }
 
 
-def _controller_signals(logs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def _controller_signals(
+    logs: dict[str, np.ndarray], responses: tuple[str, ...] = RESPONSES
+) -> dict[str, np.ndarray]:
     """The stand-up controller's signals: the response, the reference, psi, the state,
     the QP's diagnostics, what a pull held back."""
     signals = {}
     if "response" in logs:  # the robot's response to the pull, as an index of responses
         signals["response"] = np.rint(logs["response"][:, 0]).astype(np.int8)
-        signals["responses"] = np.array(RESPONSES, dtype=str)
+        signals["responses"] = np.array(responses, dtype=str)
     if "compliance_W" in logs:  # the compliant response's offset of the CoM reference
         signals["compliance_offset_W"] = logs["compliance_W"][:, :3]
     reference = COM_REFERENCE.unpack(logs["com_reference"])

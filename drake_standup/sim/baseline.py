@@ -24,6 +24,7 @@ from pathlib import Path
 from pydrake.common.yaml import yaml_dump_typed
 
 from drake_standup.config import Scenario, parse_scenario
+from drake_standup.config.plugins import resolve
 from drake_standup.outputs.json_files import write_metrics
 from drake_standup.outputs.signals import load_signals, write_signals
 from drake_standup.sim.diagram import on_step_grid
@@ -35,7 +36,8 @@ def needs_baseline(scenario: Scenario) -> bool:
     pulling. Otherwise the run is its own psi = t run."""
     human = scenario.human
     pulled = human.mode != "scripted" or bool(human.pulls)
-    return scenario.response == "advancement" and scenario.advancement.enabled and pulled
+    advances = resolve("responses", scenario.response).obj.advances
+    return advances and scenario.advancement.enabled and pulled
 
 
 def simulate_quietly(scenario: Scenario, controller: str, chunk_s: float) -> RunResult:

@@ -16,8 +16,9 @@ from pydrake.multibody.meshcat import ContactVisualizer, ContactVisualizerParams
 from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort, System
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, VectorLogSink
 
-from drake_standup.config import RESPONSES, Scenario, validate
+from drake_standup.config import Scenario, validate
 from drake_standup.config.plugins import resolve
+from drake_standup.config.responses import response_names, responses_of
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.helper.plugin import check_helper_ports
 from drake_standup.helper.work import HelperWork
@@ -74,6 +75,7 @@ class StandupDiagram:
     logs: dict[str, VectorLogSink]  # output name -> logger
     visualizer: MeshcatVisualizer | None
     plan: StandupPlan  # the phase table resolved for this robot and scene (standup/plan.py)
+    responses: tuple[str, ...]  # the run's responses, by the code the port response carries
 
     def output(self, name: str, root_context) -> np.ndarray:
         """The diagram's output name in the root context."""
@@ -130,9 +132,9 @@ def build_diagram(
             _add_visuals(builder, station, scenario, meshcat, outputs, plan.n_states)
     diagram = builder.Build()
     diagram.set_name("standup")
-    return StandupDiagram(
-        diagram, station, None if standup is None else standup.controller, logs, visualizer, plan
-    )
+    whole_body = None if standup is None else standup.controller
+    names = response_names(scenario.response)
+    return StandupDiagram(diagram, station, whole_body, logs, visualizer, plan, names)
 
 
 def _add_station_and_human(
@@ -204,7 +206,8 @@ def _add_standup_controller(
     if human.HasOutputPort("response"):
         outputs["response"] = human.GetOutputPort("response")
     else:
-        response = ConstantVectorSource([float(RESPONSES.index(scenario.response))])
+        code = response_names(scenario.response).index(scenario.response)
+        response = ConstantVectorSource([float(code)])
         outputs["response"] = builder.AddNamedSystem("response", response).get_output_port()
     builder.Connect(outputs["response"], brain.GetInputPort("response"))
     # What the controller reads: the station's truth (ideal) or the robot's own senses.
@@ -242,8 +245,10 @@ def _add_law_from_truth(
     mass = plant.CalcTotalMass(plant.CreateDefaultContext(), [robot.model_instance])
     # The law alone, evaluated where it is logged: a psi of its own would be integrated
     # at every integrator stage for nothing (0.4 ms a tick).
+    advances = tuple(r.advances for r in responses_of(response_names(scenario.response)))
     law = builder.AddNamedSystem(
-        "advancement_from_truth", AdvancementLaw(for_robot(scenario.advancement, mass))
+        "advancement_from_truth",
+        AdvancementLaw(for_robot(scenario.advancement, mass), advances=advances),
     )
     for name in ("com_W", "com_velocity_W", "omega_f_W", "hand_wrenches_W"):
         builder.Connect(world.GetOutputPort(name), law.GetInputPort(name))

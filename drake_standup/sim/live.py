@@ -44,6 +44,7 @@ from pydrake.systems.framework import (
 )
 
 from drake_standup.config import RESPONSES, HumanConfig, Scenario
+from drake_standup.config.responses import response_names
 from drake_standup.helper.hands import hand_forces, spatial_forces
 from drake_standup.robot.icub import Robot
 from drake_standup.sim.diagram import on_step_grid
@@ -112,8 +113,10 @@ class LiveHumanSource(LeafSystem):
         stand_up_button: bool = True,
         *,
         response: int = 0,
+        responses: tuple[str, ...] = RESPONSES,
     ):
         super().__init__()
+        self._responses = responses
         self._meshcat = meshcat
         self._cap = config.reactive.force_cap_N
         self._stand_up_button = stand_up_button
@@ -142,7 +145,7 @@ class LiveHumanSource(LeafSystem):
         for name in SLIDERS.values():
             m.AddSlider(name, -self._cap, self._cap, SLIDER_STEP_N, 0.0)
         m.AddSlider(TOGETHER, 0.0, 1.0, 1.0, 1.0)
-        m.AddSlider(RESPONSE, 0.0, len(RESPONSES) - 1.0, 1.0, float(self._response))
+        m.AddSlider(RESPONSE, 0.0, len(self._responses) - 1.0, 1.0, float(self._response))
         if self._stand_up_button:
             m.AddButton(STAND_UP)
 
@@ -185,9 +188,9 @@ class LiveHumanSource(LeafSystem):
         return np.column_stack([pull[:, 0], np.zeros(2), pull[:, 1]]), asked
 
     def read_response(self) -> int:
-        """The response switch's code (RESPONSES' index), as the page says now."""
+        """The response switch's code (the run's responses' index), as the page says now."""
         code = round(self._meshcat.GetSliderValue(RESPONSE))
-        return min(max(code, 0), len(RESPONSES) - 1)
+        return min(max(code, 0), len(self._responses) - 1)
 
     def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
         forces, asked = self.read_page()
@@ -246,6 +249,7 @@ class LiveSession:
         self.interrupted = False  # Ctrl-C (set by the signal handler)
         self.resets = 0
         self._response = scenario.response  # the switch's last reported setting
+        self._names = response_names(scenario.response)  # the switch's settings, by code
         self._initial_state = None
         self._reset_clicks = 0
 
@@ -260,7 +264,8 @@ class LiveSession:
             self.meshcat,
             step,
             stand_up_button=self._scenario.standup.trigger == "hands",
-            response=RESPONSES.index(self._scenario.response),
+            response=self._names.index(self._scenario.response),
+            responses=self._names,
         )
         # Below the helper's controls.
         self.meshcat.AddButton(RESET)
@@ -324,7 +329,7 @@ class LiveSession:
             self.reset(run)
             self._restart_clocks(simulator)
             return False
-        response = RESPONSES[self.human.read_response()]
+        response = self._names[self.human.read_response()]
         if response != self._response:
             self._response = response
             self._report(f"t = {run.time_s:.2f} s: the robot's response is now {response}")

@@ -48,10 +48,18 @@ class AdvancementLaw(LeafSystem):
     each). Under icub the law on the truth beside the robot's (sim/diagram.py) is one:
     logged, never integrated."""
 
-    def __init__(self, config: AdvancementConfig, *, declare_outputs: bool = True):
+    def __init__(
+        self,
+        config: AdvancementConfig,
+        *,
+        declare_outputs: bool = True,
+        advances: tuple[bool, ...] = (True, False, False),
+    ):
         """declare_outputs False: a subclass declares them after its own (the ports'
-        order: psi, psi_dot, psi_ddot, psi_dot_law, alpha)."""
+        order: psi, psi_dot, psi_ddot, psi_dot_law, alpha). advances: whether each
+        response code lets psi advance (config/responses.py; default: the shipped three)."""
         super().__init__()
+        self._advances_by_code = advances
         if config.alpha_full_mps2 is None:
             raise ValueError("advancement.alpha_full_mps2 is None: resolve it with for_robot")
         self._config = config
@@ -108,7 +116,7 @@ class AdvancementLaw(LeafSystem):
         psi = t, else the law's rate (standup/laws.py), checked and bounded."""
         config = self._config
         tangent = self._tangent.Eval(context)
-        if self._response.Eval(context)[0] > 0.5:  # stiff or compliant: psi = t
+        if not self._advances_by_code[int(round(self._response.Eval(context)[0]))]:  # psi = t
             return 1.0, helpfulness(tangent, self._omega_f.Eval(context), config.eps)
         if self._advances.Eval(context)[0] < 0.5:  # a phase that holds psi = t
             return 1.0, 0.0
@@ -170,8 +178,10 @@ class TrajectoryAdvancement(AdvancementLaw):
     law's value, the target of psi_dot).
     """
 
-    def __init__(self, config: AdvancementConfig):
-        super().__init__(config, declare_outputs=False)
+    def __init__(
+        self, config: AdvancementConfig, advances: tuple[bool, ...] = (True, False, False)
+    ):
+        super().__init__(config, declare_outputs=False, advances=advances)
         self.DeclareContinuousState(BasicVector([0.0, 1.0]))
         state = {self.all_state_ticket()}
         self.DeclareVectorOutputPort("psi", 1, self._CalcPsi, prerequisites_of_calc=state)

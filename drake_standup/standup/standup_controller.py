@@ -38,6 +38,7 @@ import numpy as np
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from drake_standup.config import Scenario
+from drake_standup.config.responses import response_names, responses_of
 from drake_standup.control.controller import WholeBodyController
 from drake_standup.control.model import ControllerJoints, ControllerModel, contact_specs
 from drake_standup.control.qp import as_slice
@@ -160,12 +161,14 @@ def _standup_systems(scenario: Scenario, station: Station, plan: StandupPlan) ->
         # The joints' friction beyond the URDF's damping is the boards' to compensate (icub).
         unknown_damping=scene.added_damping,
     )
+    responses = responses_of(response_names(scenario.response))
     return {
         "state_machine": StandupStateMachine(
             scenario.standup, table, len(station.pad_groups), station.sole_rows()
         ),
         "advancement": TrajectoryAdvancement(
-            for_robot(scenario.advancement, model.kinematics.nominal_mass_kg)
+            for_robot(scenario.advancement, model.kinematics.nominal_mass_kg),
+            tuple(r.advances for r in responses),
         ),
         "com_reference": CoMReferenceGenerator(),
         "controller": StandupWholeBodyController(
@@ -182,6 +185,7 @@ def _standup_systems(scenario: Scenario, station: Station, plan: StandupPlan) ->
                 usage_limit=scenario.standup.standing_pull_usage_limit,
                 v_joints=np.asarray(joints.v_indices),
                 trunk=np.array([i for i, n in enumerate(joints.names) if n in TRUNK_TWIST_JOINTS]),
+                responses=responses,
             ),
             WholeBodyController(
                 plant,

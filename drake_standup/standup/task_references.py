@@ -25,9 +25,10 @@ reads, each law where its task is:
                        (control/tasks/posture.py: next_posture_reference)
     base orientation   R_WB* = R(yaw_0, pitch) (control/tasks/base.py: BaseTarget)
 
-The robot's response to the pull (scenario response, config.RESPONSES) sets what of it
-acts: advancement lets f_par through; stiff and compliant compensate the whole pull
-(f_par = 0), and compliant moves the CoM target by the admittance's offset.
+The robot's response to the pull (scenario response, config/responses.py) sets what of
+it acts: a response that lets the help through (advancement) lets f_par through, the others
+compensate the whole pull (f_par = 0); one that yields (compliant) moves the CoM target by
+the admittance's offset.
 """
 
 import math
@@ -38,6 +39,10 @@ import numpy as np
 
 from drake_standup.config import RESPONSES, ComplianceConfig, ControllerConfig
 from drake_standup.config.phases import PhaseTable
+from drake_standup.config.responses import ADVANCEMENT as ADVANCING
+from drake_standup.config.responses import COMPLIANT as COMPLIANT_RESPONSE
+from drake_standup.config.responses import STIFF as STIFF_RESPONSE
+from drake_standup.config.responses import Response
 from drake_standup.control.smooth import psi_clock_blend, smoothstep
 from drake_standup.control.targets import StateReferences, TaskReferences, joint_values
 from drake_standup.control.tasks import BaseTarget, MomentumLaw, next_posture_reference
@@ -150,6 +155,7 @@ class TaskReferenceGenerator:
         usage_limit: float = 1.0,
         v_joints: np.ndarray | None = None,
         trunk: np.ndarray | None = None,
+        responses: tuple[Response, ...] = (ADVANCING, STIFF_RESPONSE, COMPLIANT_RESPONSE),
     ):
         """q_joints: the actuated joints' entries of q, in the phase references' order;
         gravity_mps2: g, the plant's. The robot's weight is that of the model the terms
@@ -159,7 +165,8 @@ class TaskReferenceGenerator:
         CoMTarget). v_joints: the actuated joints' entries of v; trunk: the trunk's
         twist joints' places among the actuated ones (robot/limbs.py: TRUNK_TWIST_JOINTS),
         held standing by the contacts (ControllerConfig.standing_trunk_attitude; None:
-        not)."""
+        not). responses: what each response code does (config/responses.py)."""
+        self._responses = responses
         self._config = config
         self.phases = phases
         self._q_joints = q_joints
@@ -253,11 +260,11 @@ class TaskReferenceGenerator:
             F_hand_W,
             carried.lean_W,
             compliance=np.zeros(6) if compliance is None else compliance,
-            compliant=response == COMPLIANT,
+            compliant=self._responses[response].yields,
             psi_dot=psi_dot,
         )
         stance, vertical_weight_scale = self._stance(state, now.path_progress)
-        helped = F_hand_W is not None and response == ADVANCEMENT
+        helped = F_hand_W is not None and self._responses[response].lets_help_through
         q_reference, next_posture, base_yaw = self._posture(terms, state, carried.posture, psi_dot)
         momentum = self.momentum.target(
             terms,

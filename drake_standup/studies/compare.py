@@ -101,11 +101,15 @@ def resolve_helper(name: str) -> Helper:
 
 
 def check_responses(names: list[str]) -> list[str]:
-    from drake_standup.config import RESPONSES
+    """names, each a response the registry resolves (a shipped one, yours by name or
+    module:attribute), without repeats."""
+    from drake_standup.config.plugins import PluginError, resolve
 
     for name in names:
-        if name not in RESPONSES:
-            raise CompareError(f"--responses {name}: unknown; accepted: {' | '.join(RESPONSES)}")
+        try:
+            resolve("responses", name)
+        except PluginError as err:
+            raise CompareError(f"--responses {name}: {str(err).partition(': ')[2]}") from None
     return list(dict.fromkeys(names))
 
 

@@ -245,7 +245,8 @@ def test_every_rule_names_a_key():
 # lead_max_m (checked against lead_min_m), the plug-ins' names (the registry resolves them:
 # rules._check_plugins, tests/plugins), the recorded helper's file (config/recording.py).
 UNBOUNDED = (
-    r"advancement\.law|human\.mode|chair\.kind|robot\.model|chair\.file|human\.recorded\.file"
+    r"advancement\.law|human\.mode|chair\.kind|response|robot\.model|chair\.file"
+    r"|human\.recorded\.file"
     r"|initial\.joints_rad\..*|phases\.\w+\.posture_rad\..*"
     r"|phases\.\w+\.base_pitch_rad"
     r"|controller\.seat_hinge_joints\[\d+\]|perturbation\.pushes\[\d+\]\.body"

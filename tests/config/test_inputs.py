@@ -140,7 +140,8 @@ BAD = {
     "response_unknown": (
         {},
         [*RUN, "--set", "response=rigid"],
-        "response: 'rigid' unknown; accepted: advancement | stiff | compliant",
+        "response: 'rigid' is not a known name; accepted: advancement | stiff | compliant, or "
+        "module:attribute",
     ),
     "compliance_negative_stiffness": (
         {},
@@ -416,7 +417,8 @@ BAD = {
     "compare_unknown_response": (
         {},
         ["compare", "--responses", "stiff", "rigid"],
-        "--responses rigid: unknown; accepted: advancement | stiff | compliant",
+        "--responses rigid: 'rigid' is not a known name; accepted: advancement | stiff | "
+        "compliant, or module:attribute",
     ),
 }
 # One of each kind through `python -m drake_standup` in a fresh process as well.

@@ -289,3 +289,43 @@ def test_a_helper_without_the_ports_or_the_shape_is_one_line():
         _helper_output("lab_helpers:portless", 0.0)
     with pytest.raises(PluginError, match=r"gave shape \(6,\) at t = 0.000 s; accepted: \(12,\)"):
         _helper_output("lab_helpers:WrongShape", 0.0)
+
+
+def test_a_bad_response_is_one_line_naming_the_key():
+    with pytest.raises(PluginError) as err:
+        resolve("responses", "lab_responses:NOT_A_RESPONSE")
+    assert str(err.value).startswith("response: 'lab_responses:NOT_A_RESPONSE' is a int;")
+
+
+def test_a_response_of_its_own_is_numbered_after_the_shipped_ones():
+    from drake_standup.config.responses import response_names
+
+    assert response_names("stiff") == ("advancement", "stiff", "compliant")
+    own = "lab_responses:ADVANCE_AND_YIELD"
+    assert response_names(own) == ("advancement", "stiff", "compliant", own)
+
+
+def _run(*overrides: str):
+    from drake_standup.sim.simulate import simulate
+
+    scenario = load_scenario(SCENARIO_DIR / "assisted.yaml", [parse_set(o) for o in overrides])
+    return simulate(scenario, None, record=False, progress=False, baseline=False)
+
+
+@pytest.mark.slow
+def test_a_response_of_its_own_acts_as_its_flags_say():
+    """The shipped stiff response by another name gives the stiff run; a response that
+    advances and yields moves psi ahead of time and the CoM reference off its path, and
+    signals.npz names it after the shipped three."""
+    stiff = _run("response=stiff")
+    again = _run("response=lab_responses:STIFF_AGAIN")
+    for key in ("standup_time_s", "psi_final", "sole_force_chatter_N", "com_tracking_rms_m"):
+        assert again.metrics[key] == stiff.metrics[key], key
+    both = _run("response=lab_responses:ADVANCE_AND_YIELD")
+    assert both.metrics["success"]
+    assert both.metrics["psi_final"] > stiff.metrics["psi_final"] + 0.5
+    assert np.abs(both.signals["compliance_offset_W"]).max() > 1e-3
+    assert not np.any(stiff.signals["compliance_offset_W"])
+    assert list(both.signals["responses"])[3] == "lab_responses:ADVANCE_AND_YIELD"
+    assert set(both.signals["response"]) == {3}
+    assert both.metrics["response"] == "lab_responses:ADVANCE_AND_YIELD"
