@@ -69,14 +69,18 @@ def _run(*overrides):
 
 @pytest.mark.slow
 def test_the_law_by_entry_point_and_by_module_attribute_is_one_law():
-    """Named both ways, the law gives the same run to the last bit, and it stands up
-    sooner than psi = t under the same pull."""
+    """Named both ways, or registered as the shipped laws are, the law gives the same run
+    to the last bit, and it stands up sooner than psi = t under the same pull."""
+    from drake_standup.plugins import register
+
+    register("laws", "gated_in_the_package", gated_law)  # as if added to the package
     by_name = _run("advancement.law=gated")
     by_path = _run("advancement.law=bring_your_own.laws:gated_law")
+    inside = _run("advancement.law=gated_in_the_package")
     stiff = _run("advancement.enabled=false")
     assert by_name["success"] and by_path["success"]
     for key in ("standup_time_s", "psi_final", "sole_force_chatter_N"):
-        assert by_name[key] == by_path[key]
+        assert by_name[key] == by_path[key] == inside[key]
     assert by_name["standup_time_s"] < stiff["standup_time_s"] - 0.1
 
 
