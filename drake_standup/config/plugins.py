@@ -7,8 +7,8 @@ A scenario names a plug-in three ways, tried in this order:
     a registered name   the shipped ones (SHIPPED), or registered by `register`
     an entry point      of the group drake_standup.<kind> of an installed distribution
 
-The shipped ones are named as entry points are, module:attribute, and load as they do:
-nothing of theirs is imported until a scenario names them.
+The shipped ones are named as entry points are, module:attribute, and load as they do, all
+of them the first time any name is resolved.
 
 An installed package makes its names known through its pyproject:
 
