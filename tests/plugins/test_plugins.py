@@ -329,3 +329,37 @@ def test_a_response_of_its_own_acts_as_its_flags_say():
     assert list(both.signals["responses"])[3] == "lab_responses:ADVANCE_AND_YIELD"
     assert set(both.signals["response"]) == {3}
     assert both.metrics["response"] == "lab_responses:ADVANCE_AND_YIELD"
+
+
+@pytest.mark.slow
+def test_a_sweep_on_two_workers_imports_a_law_from_the_current_folder(tmp_path):
+    """docs/extending.md's walk-through: a law in a module of the folder the sweep starts
+    in, not installed, imported by each Dask worker process (its own path: the registry
+    adds the current folder)."""
+    import csv
+
+    (tmp_path / "walk_law.py").write_text(
+        "def faster(inputs):\n"
+        "    return 1.3 if inputs.alpha > inputs.config.alpha_min_mps2 else 1.0\n"
+    )
+    sweep = tmp_path / "laws.yaml"
+    sweep.write_text(
+        "name: laws\nbase: assisted\nseed: 1\noverrides:\n  duration_s: 8.0\n"
+        "grid:\n  - name: law\n    path: advancement.law\n"
+        '    values: [tangent, "walk_law:faster"]\n'
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "drake_standup", "sweep", str(sweep), "--workers", "2"]
+        + ["--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=900,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    with open(tmp_path / "out" / "results.csv") as f:
+        rows = {r["law"]: r for r in csv.DictReader(f)}
+    assert rows["walk_law:faster"]["success"] == "True", rows["walk_law:faster"]
+    assert float(rows["walk_law:faster"]["standup_time_s"]) > float(
+        rows["tangent"]["standup_time_s"]
+    )

@@ -130,7 +130,7 @@ def test_a_sweep_on_two_dask_workers_runs_the_law_by_both_names(tmp_path):
 
     sweep = tmp_path / "laws.yaml"
     sweep.write_text(
-        "name: laws\nbase: assisted\nseed: 1\noverrides:\n  duration_s: 6.0\n"
+        "name: laws\nbase: assisted\nseed: 1\noverrides:\n  duration_s: 8.0\n"
         "grid:\n  - name: law\n    path: advancement.law\n"
         '    values: [gated, "bring_your_own.laws:gated_law"]\n'
     )
