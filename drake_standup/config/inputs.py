@@ -6,11 +6,10 @@ it accepts. rules.validate calls the checks of a scenario's own keys (chair.file
 or a mesh read by config/chair_mesh.py; the robot model's frames, joints and bodies); the
 entry points those of their options (--scenario and a sweep file through read_text_file,
 --out through check_output_dir). load_scenario sets a mesh chair's seat height from the
-mesh (with_mesh_seat).
+mesh (config/chair_kind.py with_chair_seat).
 """
 
 import contextlib
-import dataclasses
 import functools
 import logging
 import xml.etree.ElementTree as ET
@@ -25,7 +24,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import ModelInstanceIndex
 from pydrake.systems.framework import DiagramBuilder
 
-from drake_standup.config.chair import ChairConfig, chair_file
+from drake_standup.config.chair import chair_file
 from drake_standup.config.chair_mesh import (
     MIN_SEAT_DEPTH_M,
     MIN_SEAT_WIDTH_M,
@@ -142,16 +141,6 @@ def chair_mesh(name: str) -> ChairMesh:
 def _read_mesh(data: bytes, suffix: str) -> ChairMesh:
     """Cached per file content: a sweep validates every run, and the scene reads it again."""
     return read_chair_mesh(data, suffix)
-
-
-def with_mesh_seat(chair: ChairConfig) -> ChairConfig:
-    """chair, its seat_height_m the mesh's (to the micrometre) if chair.file is a mesh:
-    with a mesh, the seat's height is read from the mesh, whatever the scenario says
-    (load_scenario applies this; the scene refuses a mesh chair whose height disagrees)."""
-    if not chair.file or not is_mesh(chair.file):
-        return chair
-    height = round(chair_mesh(chair.file).seat.height_m, 6)
-    return dataclasses.replace(chair, seat_height_m=height)
 
 
 def add_sdf(parser: Parser, path: Path) -> list[ModelInstanceIndex]:

@@ -99,7 +99,7 @@ def chair_sdf(chair: ChairConfig) -> str:
 
 def mesh_chair_sdf(chair: ChairConfig, mesh: ChairMesh) -> str:
     """The chair mesh as SDF text, with chair's friction (its seat height is the mesh's:
-    config/inputs.py with_mesh_seat)."""
+    config/chair_kind.py with_chair_seat)."""
     seat = mesh.seat
     pose = f"{-seat.front_edge_x_m:.9g} {-seat.centre_y_m:.9g} {-seat.floor_z_m:.9g} 0 0 0"
     geometry = f"<geometry><mesh><uri>{cached_obj(mesh).as_uri()}</uri></mesh></geometry>"

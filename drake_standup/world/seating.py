@@ -281,7 +281,7 @@ def _cannot_sit(scenario: Scenario) -> str:
             "sit that far behind the seat's edge with its soles flat on the floor; accepted: "
             "null (as deep as the seat allows) or a depth it sits at on the shipped seat"
         )
-    # A mesh's seat height is the mesh's (config/inputs.py with_mesh_seat): name the file.
+    # A mesh's seat height is the mesh's (config/chair_kind.py with_chair_seat): name the file.
     key = f"chair.seat_height_m: {chair.seat_height_m:g}"
     if is_mesh(chair.file):
         key = f"chair.file: '{chair.file}' (its seat {chair.seat_height_m:g} m high)"
