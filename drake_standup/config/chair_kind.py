@@ -11,6 +11,7 @@ chair's own seat.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import tempfile
 from pathlib import Path
@@ -60,9 +61,16 @@ def _problem(model: ChairModel) -> str | None:
             return f"names the file '{path}', which is not there"
         stat = path.stat()
         return sdf_problem(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    return _sdf_text_problem(model.sdf)
+
+
+@functools.lru_cache(maxsize=16)
+def _sdf_text_problem(text: str) -> str | None:
+    """sdf_problem of SDF text, parsed once per text: validation, the seat's height at load
+    and the scene each make the chair, and each temporary file would be a new one to it."""
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "chair.sdf"
-        path.write_text(model.sdf, encoding="utf-8")
+        path.write_text(text, encoding="utf-8")
         stat = path.stat()
         return sdf_problem(str(path), stat.st_mtime_ns, stat.st_size)
 

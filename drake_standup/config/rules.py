@@ -255,8 +255,9 @@ def validate(scenario: Scenario) -> Scenario:
 
 
 def _check_plugins(scenario: Scenario) -> None:
-    """advancement.law and human.mode name plug-ins that import and fit their interface
-    (drake_standup/plugins: a registered name, module:attribute or an entry point)."""
+    """advancement.law, human.mode, response and chair.kind name plug-ins that import and
+    fit their interface (config/plugins.py: a registered name, module:attribute or an entry
+    point); the chair is made and its model checked (config/chair_kind.py)."""
     from drake_standup.config.chair_kind import make_chair
     from drake_standup.config.plugins import resolve
 
