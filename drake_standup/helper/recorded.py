@@ -1,9 +1,10 @@
 """The recorded helper (human.mode: recorded): a person's hand wrenches replayed from a
 CSV file (config/recording.py reads and checks it; its format: docs/helpers.md).
 
-RecordedWrenchSource has HumanWrenchSource's ports (helper/hands.py): robot_state in
-(read only when the samples are in the hand frame); hand_wrenches_W (12: [torque_l,
-force_l, torque_r, force_r]) and spatial_forces out. Each time its output is computed it
+RecordedWrenchSource is a HandWrenchHelper (helper/plugin.py), with HumanWrenchSource's
+ports: robot_state in (used only when the samples are in the hand frame); hand_wrenches_W
+(12: [torque_l, force_l, torque_r, force_r]) and spatial_forces out. Each time its output
+is computed it
 interpolates the samples linearly at the context's time (zero before the first sample
 and after the last), rotates them into the world if they are in the hand frame, and
 applies torques as well as forces at the hand frame's origin.
@@ -19,17 +20,11 @@ from pathlib import Path
 
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.systems.framework import Context, LeafSystem
 
 from drake_standup.config import HumanConfig, load_scenario
 from drake_standup.config.recording import load_recording, write_recording
-from drake_standup.helper.hands import (
-    TASK_FRAMES,
-    applied_wrenches,
-    declare_hand_outputs,
-    hand_forces,
-    scripted_forces,
-)
+from drake_standup.helper.hands import TASK_FRAMES, scripted_forces
+from drake_standup.helper.plugin import HandWrenchHelper
 from drake_standup.robot.icub import Robot
 
 # A force plate's rate: the shipped recording's samples. Hz.
@@ -40,29 +35,22 @@ PLATE_RATE_HZ = 1000.0
 FORCE_DECIMALS = 6
 
 
-class RecordedWrenchSource(LeafSystem):
-    """A recording's wrenches on the robot's hands, at the hand frames' origins."""
+class RecordedWrenchSource(HandWrenchHelper):
+    """A recording's wrenches on the robot's hands, at the hand frames' origins: a helper
+    as any plug-in's (helper/plugin.py), its hand_wrenches the recording's."""
 
     def __init__(self, plant: MultibodyPlant, robot: Robot, config: HumanConfig):
-        super().__init__()
+        super().__init__(plant, robot, config)
         recording = load_recording(config.recorded.file)
         self._times = recording.times_s
         # One row per column of hand_wrenches_W: what np.interp reads per column.
         self._columns = np.ascontiguousarray(recording.wrenches.T)
         self._in_hand = config.recorded.frame == "hand"
-        self._plant, self._instance = plant, robot.model_instance
         self._context = plant.CreateDefaultContext()
         self._frames = [robot.frame(plant, name) for name in TASK_FRAMES]
-        self._applied = hand_forces(plant, robot)
-        nx = plant.num_multibody_states(self._instance)
-        self._state = self.DeclareVectorInputPort("robot_state", nx)
-        prereq = {self.time_ticket()}
-        if self._in_hand:
-            prereq.add(self._state.ticket())
         # In the world frame the wrenches are a function of time alone: the last time and
         # its wrenches (the integrator sets a step's end time twice, a change to Drake).
         self._last: tuple[float, np.ndarray] | None = None
-        declare_hand_outputs(self, self._wrenches, prereq, self._applied, applied_wrenches)
 
     def sampled(self, t: float) -> np.ndarray:
         """(12,) the recording at time t in its own frame: each column interpolated
@@ -72,20 +60,19 @@ class RecordedWrenchSource(LeafSystem):
             [np.interp(t, times, column, left=0.0, right=0.0) for column in self._columns]
         )
 
-    def _wrenches(self, context: Context) -> np.ndarray:
-        """hand_wrenches_W (12,): the recording at the context's time, in the world."""
-        t = context.get_time()
+    def hand_wrenches(self, time_s: float, robot_state: np.ndarray) -> np.ndarray:
+        """hand_wrenches_W (12,): the recording at time_s, in the world."""
         if self._in_hand:
-            return self._to_world(context, self.sampled(t))
-        if self._last is None or self._last[0] != t:
-            self._last = t, self.sampled(t)
+            return self._to_world(robot_state, self.sampled(time_s))
+        if self._last is None or self._last[0] != time_s:
+            self._last = time_s, self.sampled(time_s)
         return self._last[1]
 
-    def _to_world(self, context: Context, wrenches_H: np.ndarray) -> np.ndarray:
+    def _to_world(self, robot_state: np.ndarray, wrenches_H: np.ndarray) -> np.ndarray:
         """wrenches_H (12,), each hand's torque and force in its hand frame, rotated by
-        that frame's orientation in the world now (R_WH)."""
-        plant, c = self._plant, self._context
-        plant.SetPositionsAndVelocities(c, self._instance, self._state.Eval(context))
+        that frame's orientation in the world at robot_state (R_WH)."""
+        plant, c = self.plant, self._context
+        plant.SetPositionsAndVelocities(c, self.robot.model_instance, robot_state)
         wrenches = np.empty(12)
         for i, frame in enumerate(self._frames):
             R_WH = frame.CalcRotationMatrixInWorld(c).matrix()
