@@ -252,11 +252,12 @@ def _add_law_from_truth(
     )
     for name in ("com_W", "com_velocity_W", "omega_f_W", "hand_wrenches_W"):
         builder.Connect(world.GetOutputPort(name), law.GetInputPort(name))
-    for name in ("x_d_W", "lean_W", "path_tangent_W", "path_progress", "advances", "psi"):
+    for name in (
+        *("x_d_W", "lean_W", "path_tangent_W", "path_progress", "advances"),
+        *("psi", "psi_dot", "standup_state"),
+    ):
         builder.Connect(brain.GetOutputPort(name), law.GetInputPort(name))
     builder.Connect(outputs["response"], law.GetInputPort("response"))
-    builder.Connect(brain.GetOutputPort("psi_dot"), law.GetInputPort("psi_dot"))
-    builder.Connect(brain.GetOutputPort("standup_state"), law.GetInputPort("standup_state"))
     return {
         "psi_dot_law": brain.GetOutputPort("psi_dot_law"),
         "psi_dot_law_from_truth": law.GetOutputPort("psi_dot_law"),

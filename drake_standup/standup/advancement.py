@@ -22,14 +22,8 @@ from drake_standup.standup.laws import (
     psi_dot_law,
 )
 
-# LawInputs' names read straight from an input port of the same meaning.
-_PORTS = {
-    "x_d_W": "x_d_W",
-    "com_W": "com_W",
-    "com_velocity_W": "com_velocity_W",
-    "hand_wrenches_W": "hand_wrenches_W",
-    "omega_f_W": "omega_f_W",
-}
+# LawInputs' names read straight from the input port of the same name.
+_PORTS = frozenset(("x_d_W", "com_W", "com_velocity_W", "hand_wrenches_W", "omega_f_W"))
 
 
 def _resolve_law(spec: str) -> Callable:
@@ -144,7 +138,9 @@ class AdvancementLaw(LeafSystem):
             return int(round(value)) if name == "state" else value
         if name in ("psi", "psi_dot"):
             return self._psi_now(context)[0 if name == "psi" else 1]
-        return self.GetInputPort(_PORTS[name]).Eval(context)
+        if name not in _PORTS:
+            raise KeyError(f"LawInputs: no input '{name}'")
+        return self.GetInputPort(name).Eval(context)
 
     def _psi_now(self, context: Context) -> tuple[float, float]:
         """psi and psi_dot, from the inputs psi and psi_dot (NaN where not connected)."""
