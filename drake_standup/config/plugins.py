@@ -149,6 +149,8 @@ def _find(kind: str, spec: str) -> Plugin:
     if not isinstance(spec, str) or not spec:
         raise PluginError(f"{key}: {spec!r}; accepted: {accepted(kind)}")
     if ":" in spec:
+        if os.getcwd() not in sys.path:  # a module in the current folder, as `python -m`
+            sys.path.append(os.getcwd())
         return Plugin(spec, _import(key, spec), "module", "")
     if spec in _REGISTERED[kind]:
         return _REGISTERED[kind][spec]
@@ -163,8 +165,6 @@ def _import(key: str, spec: str) -> Any:
     module_name, _, attribute = spec.partition(":")
     if not module_name or not attribute:
         raise PluginError(f"{key}: '{spec}' is not module:attribute; accepted: e.g. mylab.laws:law")
-    if os.getcwd() not in sys.path:  # a module in the current folder, as `python -m` finds it
-        sys.path.append(os.getcwd())
     try:
         obj = importlib.import_module(module_name)
     except Exception as err:  # noqa: BLE001 - whatever the user's module raises, one line
