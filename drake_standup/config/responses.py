@@ -40,6 +40,12 @@ COMPLIANT = Response(advances=False, lets_help_through=False, yields=True)
 """psi = t, and the CoM reference yields to the pull through an admittance."""
 
 
+# The shipped responses in RESPONSES' order: what the codes 0, 1, 2 do.
+SHIPPED = (ADVANCEMENT, STIFF, COMPLIANT)
+# Whether each shipped code lets psi advance.
+SHIPPED_ADVANCES = tuple(response.advances for response in SHIPPED)
+
+
 def response_names(response: str) -> tuple[str, ...]:
     """The run's responses by number: RESPONSES, then response if it is none of them."""
     return RESPONSES if response in RESPONSES else (*RESPONSES, response)

@@ -12,6 +12,7 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, Context, ContinuousState, LeafSystem
 
 from drake_standup.config import AdvancementConfig
+from drake_standup.config.responses import SHIPPED_ADVANCES
 from drake_standup.ports.caching import declare_cached
 from drake_standup.standup.laws import (
     LawInputs,
@@ -47,7 +48,7 @@ class AdvancementLaw(LeafSystem):
         config: AdvancementConfig,
         *,
         declare_outputs: bool = True,
-        advances: tuple[bool, ...] = (True, False, False),
+        advances: tuple[bool, ...] = SHIPPED_ADVANCES,
     ):
         """declare_outputs False: a subclass declares them after its own (the ports'
         order: psi, psi_dot, psi_ddot, psi_dot_law, alpha). advances: whether each
@@ -174,9 +175,7 @@ class TrajectoryAdvancement(AdvancementLaw):
     law's value, the target of psi_dot).
     """
 
-    def __init__(
-        self, config: AdvancementConfig, advances: tuple[bool, ...] = (True, False, False)
-    ):
+    def __init__(self, config: AdvancementConfig, advances: tuple[bool, ...] = SHIPPED_ADVANCES):
         super().__init__(config, declare_outputs=False, advances=advances)
         self.DeclareContinuousState(BasicVector([0.0, 1.0]))
         state = {self.all_state_ticket()}

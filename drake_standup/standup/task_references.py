@@ -39,10 +39,7 @@ import numpy as np
 
 from drake_standup.config import RESPONSES, ComplianceConfig, ControllerConfig
 from drake_standup.config.phases import PhaseTable
-from drake_standup.config.responses import ADVANCEMENT as ADVANCING
-from drake_standup.config.responses import COMPLIANT as COMPLIANT_RESPONSE
-from drake_standup.config.responses import STIFF as STIFF_RESPONSE
-from drake_standup.config.responses import Response
+from drake_standup.config.responses import SHIPPED, Response
 from drake_standup.control.smooth import psi_clock_blend, smoothstep
 from drake_standup.control.targets import StateReferences, TaskReferences, joint_values
 from drake_standup.control.tasks import BaseTarget, MomentumLaw, next_posture_reference
@@ -155,7 +152,7 @@ class TaskReferenceGenerator:
         usage_limit: float = 1.0,
         v_joints: np.ndarray | None = None,
         trunk: np.ndarray | None = None,
-        responses: tuple[Response, ...] = (ADVANCING, STIFF_RESPONSE, COMPLIANT_RESPONSE),
+        responses: tuple[Response, ...] = SHIPPED,
     ):
         """q_joints: the actuated joints' entries of q, in the phase references' order;
         gravity_mps2: g, the plant's. The robot's weight is that of the model the terms
