@@ -120,7 +120,8 @@ def _obj_index(word: str, count: int) -> int:
 
 
 def read_stl(data: bytes) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices (three per triangle) and triangles of a binary or an ASCII STL file."""
+    """Vertices (three per triangle) and triangles of a binary or an ASCII STL file (the
+    one STL reader: robot/meshes.py reads the iCub's meshes with it too)."""
     if len(data) >= 84:
         count = int(np.frombuffer(data, "<u4", 1, 80)[0])
         if len(data) == 84 + 50 * count and count:

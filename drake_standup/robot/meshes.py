@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from drake_standup.config.chair_mesh import read_stl as read_stl_file
+
 # Bump when the conversion changes so stale cache entries are not reused.
 _CONVERTER_VERSION = "1"
 
@@ -34,20 +36,7 @@ def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
     Coincident corners are merged so the mesh is indexed, which both shrinks
     the OBJ and lets the decimator see the connectivity.
     """
-    data = Path(path).read_bytes()
-    n_tri = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
-    if n_tri >= 0 and len(data) == 84 + 50 * n_tri:
-        record = np.dtype([("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attr", "<u2")])
-        corners = np.frombuffer(data, dtype=record, count=n_tri, offset=84)["corners"]
-    else:
-        words = data.decode("ascii", errors="replace").split()
-        coords = [
-            [float(words[i + 1]), float(words[i + 2]), float(words[i + 3])]
-            for i, w in enumerate(words)
-            if w == "vertex"
-        ]
-        corners = np.asarray(coords, dtype=np.float64).reshape(-1, 3, 3)
-    corners = np.asarray(corners, dtype=np.float64).reshape(-1, 3)
+    corners, _ = read_stl_file(Path(path).read_bytes())  # three corners a triangle
     vertices, inverse = np.unique(corners, axis=0, return_inverse=True)
     faces = inverse.reshape(-1, 3)
     keep = (
