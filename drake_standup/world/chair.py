@@ -21,6 +21,7 @@ from pathlib import Path
 from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig, ChairModel, chair_file
 from drake_standup.config.chair_mesh import ChairMesh, is_mesh, obj_text
 from drake_standup.config.inputs import chair_mesh
+from drake_standup.robot.meshes import cache_dir
 
 # The shipped chair's look (models/chair.sdf): seat 0.40 m deep, 0.44 m wide; legs
 # 0.04 m square, inset 0.03 m; a backrest 0.03 m thick from 0.02 m above the seat. m.
@@ -120,10 +121,11 @@ def mesh_chair_sdf(chair: ChairConfig, mesh: ChairMesh) -> str:
 
 
 def cached_obj(mesh: ChairMesh) -> Path:
-    """The mesh as a plain OBJ file (Drake reads OBJ, not STL), in the temporary folder,
-    named by its content: written once, atomically, for every run that loads it."""
+    """The mesh as a plain OBJ file (Drake reads OBJ, not STL), in the generated-asset cache
+    beside the robot's converted meshes (robot/meshes.py cache_dir), named by its content:
+    written once, atomically, for every run that loads it."""
     text = obj_text(mesh)
-    folder = Path(tempfile.gettempdir()) / "drake_standup_chairs"
+    folder = cache_dir() / "chairs"
     path = folder / f"{hashlib.sha256(text.encode()).hexdigest()[:20]}.obj"
     if not path.is_file():
         folder.mkdir(parents=True, exist_ok=True)
