@@ -8,7 +8,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from drake_standup.config.resources import data_root
+from drake_standup.config.resources import own_or_shipped
 
 
 def _seated_joints() -> dict[str, float]:
@@ -116,8 +116,7 @@ class ChairConfig:
 def chair_file(name: str) -> Path:
     """chair.file as a path: the user's own file (or folder: config.inputs names it), else a
     shipped one such as models/chair.sdf, else the name as given (config.inputs: missing)."""
-    own, shipped = Path(name), data_root() / name
-    return shipped if not own.is_absolute() and not own.exists() and shipped.is_file() else own
+    return own_or_shipped(name)
 
 
 @dataclass(frozen=True)

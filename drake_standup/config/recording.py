@@ -22,7 +22,7 @@ import numpy as np
 
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.inputs import read_text_file
-from drake_standup.config.resources import data_root
+from drake_standup.config.resources import own_or_shipped
 
 # human.recorded.frame's settings: the frame the file's samples are written in.
 FRAMES = ("world", "hand")
@@ -82,8 +82,7 @@ class _RecordingError(Exception):
 def recording_file(name: str) -> Path:
     """human.recorded.file as a path: the user's own file, else a shipped one such as
     recordings/default_pull.csv (under the data root), else the name as given."""
-    own, shipped = Path(name), data_root() / name
-    return shipped if not own.is_absolute() and not own.exists() and shipped.is_file() else own
+    return own_or_shipped(name)
 
 
 def load_recording(name: str) -> Recording:

@@ -29,6 +29,15 @@ def shipped(folder: str) -> dict[str, Path]:
     return {p.stem: p for p in sorted((data_root() / folder).glob("*.yaml"))}
 
 
+def own_or_shipped(name: str) -> Path:
+    """A file a scenario names (chair.file, human.recorded.file): the user's own (absolute,
+    or relative to the current folder), else the shipped one of that path under the data
+    root (models/chair.sdf, recordings/default_pull.csv), else the name as given (its
+    check then says it is missing)."""
+    own, shipped = Path(name), data_root() / name
+    return shipped if not own.is_absolute() and not own.exists() and shipped.is_file() else own
+
+
 def model_file(name: str) -> Path:
     """A shipped model file, e.g. model_file('chair.sdf')."""
     return data_root() / "models" / name
