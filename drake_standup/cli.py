@@ -34,7 +34,7 @@ COMMANDS = {
     ),
     "convergence": ("drake_standup.studies.convergence", "the plant-step convergence study"),
     "scenarios": ("drake_standup.cli", "list the shipped scenarios and sweeps"),
-    "list": ("drake_standup.cli", "list the plug-ins by kind: laws, helpers, chairs, responses, yours too"),
+    "list": ("drake_standup.cli", "plug-ins by kind: laws, helpers, chairs, responses"),
 }
 
 
