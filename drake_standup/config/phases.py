@@ -34,6 +34,10 @@ from dataclasses import dataclass, field
 
 # The phases in the order of the stand-up states 1-4.
 PHASES = ("seated", "forward", "lift_off", "rise")
+# The sit-down's phases, states 5-7 (entered only where sit_down.trigger asks for one):
+# each the reverse of a stand-up phase, back to `seated` (state 1).
+DESCENT = ("lower", "land", "settle")
+EVERY_PHASE = PHASES + DESCENT
 # Pad groups of the chair whose load a phase can release (models/icub_contact.yaml).
 SEAT_PADS = ("buttocks", "thighs")
 # The seat's pads in the one order every consumer keeps (the station's
@@ -41,8 +45,13 @@ SEAT_PADS = ("buttocks", "thighs")
 # frame (robot.TASK_FRAMES' key) and the group a phase releases it with.
 SEAT_PAD_ROWS = (("buttocks", "buttocks"), ("l_thigh", "thighs"), ("r_thigh", "thighs"))
 SEAT_HOLDS = ("held", "hinged")
-# What a phase does under a pull against the stand-up (standup/transitions.py).
-WHEN_HINDERED = ("wait", "sit_back", "step_back", "stand")
+# What a phase does under a pull against the stand-up (standup/transitions.py); a
+# sit-down phase under a pull against the sit-down: stand (back up, state 4) or hold.
+WHEN_HINDERED = ("wait", "sit_back", "step_back", "stand", "hold")
+# Where a sit-down phase's segment ends: where that stand-up phase's segment started
+# (the robot's own path on this chair, reversed), or at the seated CoM (x, y; its
+# height follows the CoM).
+RETURNS_TO = ("rise", "lift_off", "seated")
 
 _LEGS = ("hip_pitch", "hip_roll", "knee", "ankle_pitch")
 _ARMS = ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
@@ -74,7 +83,8 @@ class Guard:
     # done at once). It keeps the reference's slope continuous across the switch.
     segment_done: bool = True
     # The pads this phase unloads have finished unloading (unload_s after their release
-    # began: at entry, or once unload_when holds).
+    # began: at entry, or once unload_when holds); in a sit-down phase, the pads it
+    # lands have finished landing (load_s after their touch).
     unloaded: bool = False
     # Both soles together carry more than this (filtered, Schmitt trigger). N.
     feet_force_N: float | None = None
@@ -83,6 +93,9 @@ class Guard:
     # The CoM at least this far in front of the soles' heel edge ([early-probe]: the feet's
     # forces alone fired with the CoM behind the heels). m.
     com_ahead_of_heels_m: float | None = None
+    # A sit-down phase ends early (its segment not yet done) once the thigh pads'
+    # undersides are this near the seat's top (the measured thigh_gap_m). m.
+    thighs_within_m: float | None = None
 
 
 @dataclass
@@ -142,10 +155,25 @@ class Phase:
     unload_when: float | None = None
     # The CoM target leans against the hands' pull (the feet alone carry the robot).
     lean: bool = False
-    # The legs' posture, not the CoM height, ends the segment (controller.stance_*).
+    # The legs' posture, not the CoM height, ends the segment (controller.stance_*); or
+    # sets the height all along it (stance_throughout).
     stance: bool = False
+    stance_throughout: bool = False
     # psi may run ahead of time here (advancement.py).
     advances: bool = True
+    # Sit-down phases: the segment ends where the stand-up phase named here started
+    # (RETURNS_TO); the posture is that phase's, as the plan resolved it (empty: the
+    # seated pose held). Pad groups landed here: from the measured touch
+    # (sit_down.touch_force_N), the load the QP may ask of them rises from 0 to what they
+    # carried before their release, over load_s (smoothstep). s.
+    returns_to: str | None = None
+    posture_as: str | None = None
+    # Its path done with a pad it lands not yet touching the seat, the reference creeps
+    # this much lower (over load_s) until the touch; from the touch the reference's
+    # height follows the CoM (the seat takes it). m.
+    sink_m: float = 0.0
+    load: list[str] = field(default_factory=list)
+    load_s: float = 0.0
     # The answer to a pull against the stand-up (WHEN_HINDERED).
     when_hindered: str = "wait"
     exit: Guard = field(default_factory=Guard)
@@ -234,12 +262,69 @@ class PhaseTable:
         )
     )
 
+    # 5: lower over the feet to where the rise started: the rise reversed, the feet
+    # carrying the robot (the lift-off's posture and gains, the CoM leaning against the
+    # pull). A pull against the sit-down stands the robot back up.
+    lower: Phase = field(
+        default_factory=lambda: Phase(
+            segment_psi=1.8,
+            returns_to="rise",
+            posture_as="lift_off",
+            com_kp_per_s2=[60.0, 40.0, 30.0],
+            base_pitch_rad=0.3,
+            seat_hold="hinged",
+            stance=True,
+            when_hindered="stand",
+        )
+    )
+    # 6: back to where the lift-off started, the thighs landing: their load planned from
+    # the touch over the lift-off's own 0.7 s (its release reversed), the forward's
+    # posture. Longer than the lift-off (1.0 psi): the CoM goes back over the heels.
+    land: Phase = field(
+        default_factory=lambda: Phase(
+            segment_psi=1.0,
+            returns_to="lift_off",
+            sink_m=0.03,
+            posture_as="forward",
+            com_kp_per_s2=[60.0, 40.0, 30.0],
+            base_pitch_rad=0.4,
+            seat_hold="hinged",
+            load=["thighs"],
+            load_s=0.7,
+            lean=True,
+            stance=True,
+            stance_throughout=True,
+            when_hindered="hold",
+            exit=Guard(unloaded=True),
+        )
+    )
+    # 7: back to the seated CoM, the pelvis upright, the buttocks landing, the arms
+    # back in the lap (the seated pose held: the helper's hands let go); its height
+    # follows the CoM as the forward's did. Then state 1, seated.
+    settle: Phase = field(
+        default_factory=lambda: Phase(
+            segment_psi=1.5,
+            returns_to="seated",
+            com_height_follows=True,
+            seat_hold="hinged",
+            load=["buttocks"],
+            load_s=0.5,
+            when_hindered="hold",
+            exit=Guard(unloaded=True),
+        )
+    )
+
     def phase(self, state: int) -> Phase:
-        """The phase of stand-up state 1-4."""
-        return getattr(self, PHASES[state - 1])
+        """The phase of state 1-7 (stand-up 1-4, sit-down 5-7)."""
+        return getattr(self, EVERY_PHASE[state - 1])
 
     def __iter__(self):
+        """The stand-up's phases, states 1-4."""
         return (getattr(self, name) for name in PHASES)
+
+    def every(self) -> list[Phase]:
+        """Every phase, states 1-7: the stand-up's, then the sit-down's."""
+        return [getattr(self, name) for name in EVERY_PHASE]
 
     def unresolved_heights(self) -> list[str]:
         """The phases whose end height waits for the robot (com_height_erect, no
@@ -249,6 +334,13 @@ class PhaseTable:
             for name, phase in zip(PHASES, self, strict=True)
             if phase.com_height_erect and phase.com_height_m is None
         ]
+
+    def landing_phase(self, pads: str) -> int | None:
+        """The sit-down state (5-7) that lands a pad group, None if none."""
+        for state, phase in enumerate(self.every()[len(PHASES) :], start=len(PHASES) + 1):
+            if pads in phase.load:
+                return state
+        return None
 
     def unloading_phase(self, pads: str) -> int | None:
         """The state (1-4) whose entry starts the release of a pad group, None if none."""
@@ -275,6 +367,17 @@ def resolve_com_heights(table: PhaseTable, erect_height_m) -> PhaseTable:
     for name in table.unresolved_heights():
         phase = getattr(resolved, name)
         phase.com_height_m = float(erect_height_m(phase.posture_rad))
+    return resolved
+
+
+def resolve_descent(table: PhaseTable) -> PhaseTable:
+    """A copy of table whose sit-down phases with a posture_as and no posture of their own
+    take that (resolved) phase's posture."""
+    resolved = copy.deepcopy(table)
+    for name in DESCENT:
+        phase = getattr(resolved, name)
+        if phase.posture_as is not None and not phase.posture_rad:
+            phase.posture_rad = dict(getattr(resolved, phase.posture_as).posture_rad)
     return resolved
 
 

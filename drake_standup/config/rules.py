@@ -22,9 +22,15 @@ from drake_standup.config.controller import MODEL_LIBRARIES, MOMENTUM_INTEGRAL_A
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.hardware import HARDWARE
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
-from drake_standup.config.phases import SEAT_HOLDS, SEAT_PADS, WHEN_HINDERED
+from drake_standup.config.phases import (
+    PHASES,
+    RETURNS_TO,
+    SEAT_HOLDS,
+    SEAT_PADS,
+    WHEN_HINDERED,
+)
 from drake_standup.config.recording import FRAMES, load_recording
-from drake_standup.config.scenario import REFLECTED_INERTIA, Scenario
+from drake_standup.config.scenario import REFLECTED_INERTIA, SIT_DOWN_TRIGGERS, Scenario
 
 
 @dataclass(frozen=True)
@@ -83,6 +89,11 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (Range(low=0.0, high=5.0), "hardware.*_scale"),
     (PLANT_STEP, "hardware.plant_time_step_s"),
     (("hands", "time"), "standup.trigger"),
+    (SIT_DOWN_TRIGGERS, "standup.sit_down.trigger"),
+    (Range(low=1.0, high=100.0, text="a whole number 1-100", integer=True), "standup.sit_down.times"),
+    (RETURNS_TO, "phases.*.returns_to"),
+    (PHASES, "phases.*.posture_as"),
+    (SEAT_PADS, "phases.*.load[*]"),
     (SEAT_HOLDS, "phases.*.seat_hold phases.*.seat_hold_sat_back"),
     (SEAT_PADS, "phases.*.unload[*]"),
     (WHEN_HINDERED, "phases.*.when_hindered"),
@@ -122,7 +133,7 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "human.reactive.damping_Ns_per_m human.reactive.travel_m "
         "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
         "human.reactive.ease_com_rise_m advancement.alpha_*_mps2 advancement.lag_tolerance_m "
-        "standup.*_s standup.*_N phases.*.unload_s phases.*.exit.* phases.*.com_kp_per_s2 "
+        "standup.*_s standup.*_N standup.sit_down.*_s standup.sit_down.*_N phases.*.unload_s phases.*.load_s phases.*.exit.* phases.*.com_kp_per_s2 "
         "controller.*_weight controller.*_weight_s controller.contact_velocity_gain_per_s "
         "controller.*weight_by_joint.* controller.*_kp_* controller.*_kd_* controller.*_ki_* "
         "controller.*_damping_ratio controller.posture_limit_margin_rad controller.*_N "

@@ -230,6 +230,31 @@ class ComplianceConfig:
     max_offset_m: list[float] = field(default_factory=lambda: [0.04, 0.03, 0.03])
 
 
+# What starts a sit-down from standing (standup.sit_down.trigger): none (the robot stays
+# up), hands (the helper's pull back and down, or the live page's Sit down button),
+# time (standing stand_s).
+SIT_DOWN_TRIGGERS = ("none", "hands", "time")
+
+
+@dataclass
+class SitDownConfig:
+    """The sit-down after standing (states 5-7, phases.DESCENT), and standing again."""
+
+    trigger: str = "none"
+    # Standing this long (the rise's segment done) before the clock sits the robot down;
+    # the hands' and the button's sit-down waits for standup.resume_after_s of standing. s.
+    stand_s: float = 3.0
+    # Seated again, the robot balances this long before a stand-up may be asked again
+    # (the seated phase's min_time_s is the first stand-up's). s.
+    seated_s: float = 2.0
+    # How many sit-downs a run makes at most.
+    times: int = 1
+    # A pad group has touched the seat once its pads' filtered normal force exceeds this
+    # (the metrics' unloading level is 5 N: above the 1-3 N a compliant pad feels while
+    # the thigh brushes it). N.
+    touch_force_N: float = 10.0
+
+
 @dataclass
 class StandupConfig:
     """The state machine's settings across phases ([authors-code], [early-probe]); what each
@@ -285,6 +310,8 @@ class StandupConfig:
     # Period of the state machine's update; the authors' whole controller ran at 100 Hz
     # ([authors-code]), and the guards' thresholds are met for seconds. s.
     update_period_s: float = 0.01
+    # After standing: the sit-down, and standing again.
+    sit_down: SitDownConfig = field(default_factory=SitDownConfig)
 
 
 @dataclass

@@ -34,6 +34,11 @@ class StateReferences:
     stance: bool  # the legs' posture, not the CoM height, ends the segment (state 4)
     # The CoM target's height offset where it leans (the arms braced stand lower), m.
     com_height_offset_m: float = 0.0
+    # A sit-down phase's posture returns to the one the robot had entering this stand-up
+    # state (1: as it sat), along the CoM's path (0: the posture target as it is).
+    posture_returns_to: int = 0
+    # The stance acts over the whole segment, not only its end.
+    stance_throughout: bool = False
 
 
 @dataclass(slots=True)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from drake_standup.helper.work import HELPER_SPENT
+from drake_standup.outputs.cycle import first_entry_times, sit_down_metrics
 from drake_standup.outputs.estimation import estimation_metrics
 from drake_standup.outputs.signals import group_mean_normal_forces, group_normal_forces
 from drake_standup.robot.limbs import (
@@ -343,7 +344,8 @@ def sit_backs(state: np.ndarray) -> int:
     """How often the stand-up went back to state 1 once it had left it (a pull against
     it sat it back), from the state's samples."""
     state = np.asarray(state)
-    return int(np.count_nonzero((state[1:] == 1) & (state[:-1] > 1)))
+    # From the stand-up's states only: a sit-down (5-7) ends in state 1 as asked.
+    return int(np.count_nonzero((state[1:] == 1) & (state[:-1] > 1) & (state[:-1] <= 4)))
 
 
 def run_metrics(
@@ -372,6 +374,9 @@ def run_metrics(
     samples = len(signals["time_s"])
     twist, twisted = torso_twist(signals, joint_limits_rad(plant, instance, TRUNK_TWIST_JOINTS))
     metrics.update(twist)
+    cycle = sit_down_metrics(signals) if psi_final is not None and samples else {}
+    if cycle:  # a cycle's stand-up is its first (the state machine's entries are its last)
+        entry_times_s = first_entry_times(signals["state"], signals["time_s"])
     if psi_final is not None:
         metrics.update(advancement_metrics(psi_final, signals["psi_dot"], entry_times_s))
         metrics.update(
@@ -418,6 +423,7 @@ def run_metrics(
             signals["com_W"], signals["com_reference_W"]
         )
     metrics.update(limb_metrics(signals))
+    metrics.update(cycle)
     metrics.update(estimation_metrics(signals))
     torques = signals["joint_torques_Nm"]
     metrics["max_abs_torque_Nm"] = float(np.abs(torques).max()) if torques.size else None

@@ -44,6 +44,7 @@ _SENSED = (
     "omega_f_W",
     "heel_x_W",
     "thigh_x_W",
+    "thigh_z_W",
     "standing_pull_usage",
     "braced_pull_usage",
     "pull_cop_shift_m",

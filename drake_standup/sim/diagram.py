@@ -219,9 +219,9 @@ def _add_standup_controller(
     for i in range(brain.num_input_ports()):
         port = brain.get_input_port(i)
         name = port.get_name()
-        if name == "stand_up":
-            if human.HasOutputPort("stand_up"):
-                builder.Connect(human.GetOutputPort("stand_up"), port)
+        if name in ("stand_up", "sit_down"):
+            if human.HasOutputPort(name):
+                builder.Connect(human.GetOutputPort(name), port)
         elif name != "response":
             source = senses.controller_inputs[name] if senses else world.GetOutputPort(name)
             builder.Connect(source, port)

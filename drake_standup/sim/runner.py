@@ -223,7 +223,10 @@ def collect(run: Run) -> RunResult:
     reason = run.failure_reason
     if reason is None and built.controller is not None:
         stood = metrics.get("standup_time_s") is not None
-        if metrics.get("standing_at_end", False) and stood:
+        # A cycle may end seated: its last sit-down landed and the robot sits at the end.
+        sat = bool(metrics.get("sit_downs")) and metrics["sit_downs"][-1]["seated_s"] is not None
+        sat = sat and int(signals["state"][-1]) == 1
+        if stood and (metrics.get("standing_at_end", False) or sat):
             reason = None
         elif not stood and metrics.get("held_back_s", 0.0) > 0.0:
             beyond = metrics.get("held_back_beyond_feet_s", 0.0)

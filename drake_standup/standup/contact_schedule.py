@@ -35,7 +35,12 @@ import numpy as np
 from drake_standup.config import ControllerConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.control.contacts import CHAIR, CONTACTS, SOLES, ContactCommands
-from drake_standup.standup.transitions import StandupMode, seat_loads, seat_releases
+from drake_standup.standup.transitions import (
+    StandupMode,
+    seat_landings,
+    seat_loads,
+    seat_releases,
+)
 
 
 def next_unload_from(
@@ -124,9 +129,14 @@ class ContactSchedule:
         self._config = config
         self._table = table
         self._releases = seat_releases(table)
+        self._landings = seat_landings(table)
         # The commands once every pad is released: constant, so computed once.
         self._released = contact_commands(config, np.zeros(3), np.zeros(3), None, "free")
         self._first_release = min((release[0] for release in self._releases), default=math.inf)
+
+    @property
+    def table(self) -> PhaseTable:
+        return self._table
 
     def tick(
         self,
@@ -147,7 +157,7 @@ class ContactSchedule:
                 self._config, _SEATED, _SEATED, measured_N(), phase_seat_hold(mode, self._table)
             )
             return commands, np.concatenate((last, last))
-        loads = seat_loads(mode, t, self._releases)
+        loads = seat_loads(mode, t, self._releases, self._landings)
         if not np.count_nonzero(loads):  # every pad released (NaN, seated, counts as nonzero)
             return self._released, np.concatenate((memory[:3], last))
         unload_from = next_unload_from(memory[:3], last, loads)

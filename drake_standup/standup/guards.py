@@ -57,6 +57,10 @@ class GuardSignals:
     # both hands' helping pull (forward and up) > gentle_pull_force_N for
     # gentle_pull_time_s
     hands_held: SchmittTrigger = _OFF
+    # both hands pulled the sit-down's way (back and down, lowering_pull_N) by more than
+    # gentle_pull_force_N for gentle_pull_time_s: the helper asks for the sit-down.
+    hand_lower_N: tuple[float, float] = (0.0, 0.0)  # filtered lowering_pull_N
+    hands_lowered: SchmittTrigger = _OFF
     feet_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # the feet together
     each_foot_loaded: tuple[SchmittTrigger, ...] = (_OFF,) * N_STATES  # each foot
     # A pull against the stand-up: one needing more than standing_pull_usage_limit of
@@ -112,6 +116,14 @@ class Measurements:
     # Someone asked for the stand-up (live mode's "Stand up" button): with
     # trigger 'hands', as good as the pull.
     stand_up: bool = False
+    # The seat pads' normal forces, buttocks, left and right thigh (phases.SEAT_PAD_ROWS;
+    # NaN: not measured): what tells the sit-down its thighs and buttocks have touched. N.
+    seat_fz_N: tuple[float, float, float] = (math.nan, math.nan, math.nan)
+    # Someone asked for the sit-down (live mode's "Sit down" button).
+    sit_down: bool = False
+    # How high the thigh pads' undersides are above the seat's top (kinematics: on the
+    # iCub, the encoders and the base estimate; NaN: not known). m.
+    thigh_gap_m: float = math.nan
 
 
 # A pull that lifts the robot uses its reach this many times over (it stays finite
@@ -140,6 +152,11 @@ def helping_pull_N(fx_N: float, fz_N: float) -> float:
     return math.hypot(max(fx_N, 0.0), max(fz_N, 0.0))
 
 
+def lowering_pull_N(fx_N: float, fz_N: float) -> float:
+    """The part of a hand's pull that goes the sit-down's way, back and down."""
+    return math.hypot(max(-fx_N, 0.0), max(-fz_N, 0.0))
+
+
 def _low_pass(previous: tuple[float, ...], raw: tuple[float, ...], gain: float) -> tuple:
     return tuple(float(y + gain * (x - y)) for y, x in zip(previous, raw, strict=True))
 
@@ -154,8 +171,10 @@ def update_guards(
     braced_raw = m.braced_usage if can_brace else 0.0
     heel_raw = heel_usage(m, table)
     help_raw = tuple(helping_pull_N(x, z) for x, z in zip(m.hand_fx_N, m.hand_fz_N, strict=True))
+    lower_raw = tuple(lowering_pull_N(x, z) for x, z in zip(m.hand_fx_N, m.hand_fz_N, strict=True))
     if math.isnan(g.t):
         feet, hands, helping = tuple(m.foot_fz_N), tuple(m.hand_fx_N), help_raw
+        lowering = lower_raw
         usage, braced, heel = m.pull_usage, braced_raw, heel_raw
     else:
         tau = cfg.force_filter_time_constant_s
@@ -163,6 +182,7 @@ def update_guards(
         feet = _low_pass(g.foot_fz_N, m.foot_fz_N, gain)
         hands = _low_pass(g.hand_fx_N, m.hand_fx_N, gain)
         helping = _low_pass(g.hand_help_N, help_raw, gain)
+        lowering = _low_pass(g.hand_lower_N, lower_raw, gain)
         usage, braced, heel = _low_pass(
             (g.pull_usage, g.braced_usage, g.heel_usage), (m.pull_usage, braced_raw, heel_raw), gain
         )
@@ -197,6 +217,10 @@ def update_guards(
         hands_pulled=g.hands_pulled.update(min(hands), m.t, hand_on, off * hand_on, dwell),
         hands_held=g.hands_held.update(
             min(helping), m.t, gentle, off * gentle, max(dwell, cfg.gentle_pull_time_s)
+        ),
+        hand_lower_N=lowering,
+        hands_lowered=g.hands_lowered.update(
+            min(lowering), m.t, gentle, off * gentle, max(dwell, cfg.gentle_pull_time_s)
         ),
         feet_loaded=tuple(
             trigger(k, sum(feet), e.feet_force_N) for k, e in zip(g.feet_loaded, exits)

@@ -13,8 +13,10 @@ from dataclasses import dataclass
 from drake_standup.config import ControllerConfig, Scenario
 from drake_standup.config.chair import SEATED_JOINTS
 from drake_standup.config.phases import (
+    EVERY_PHASE,
     PHASES,
     PhaseTable,
+    resolve_descent,
     resolve_com_heights,
     resolve_com_x,
     resolve_postures,
@@ -42,13 +44,14 @@ class StandupPlan:
 
     @property
     def states(self) -> tuple[int, ...]:
-        """1 to n_states: the modes the controller's tasks are active in."""
-        return tuple(range(1, self.n_states + 1))
+        """The stand-up's and the sit-down's states (1-7): the modes the controller's
+        tasks are active in."""
+        return tuple(range(1, len(EVERY_PHASE) + 1))
 
     @property
     def stance_states(self) -> set[int]:
         """The states whose phase ends on the legs' posture (the stance tasks act)."""
-        return {k for k, phase in enumerate(self.table, start=1) if phase.stance}
+        return {k for k, phase in enumerate(self.table.every(), start=1) if phase.stance}
 
 
 def feet_reach(config: ControllerConfig) -> FeetReach:
@@ -82,5 +85,5 @@ def make_plan(scenario: Scenario, station: Station) -> StandupPlan:
     soles_x = scenario.chair.seat_edge_x_m() + seated.feet_ahead_of_seat_edge_m
     shift, limits = seated_shift(station.scene)
     table = resolve_postures(scenario.phases, shift, limits, JOINT_MARGIN_RAD)
-    table = resolve_com_heights(resolve_com_x(table, soles_x), erect)
+    table = resolve_descent(resolve_com_heights(resolve_com_x(table, soles_x), erect))
     return StandupPlan(table, erect(scenario.phases.rise.posture_rad))

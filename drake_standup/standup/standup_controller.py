@@ -60,12 +60,15 @@ _WIRES = [
     ("state_machine", "com_W", "", "com_W"),
     ("state_machine", "heel_x_W", "", "heel_x_W"),
     ("state_machine", "thigh_x_W", "", "thigh_x_W"),
+    ("state_machine", "thigh_z_W", "", "thigh_z_W"),
     ("state_machine", "standing_pull_usage", "", "standing_pull_usage"),
     ("state_machine", "braced_pull_usage", "", "braced_pull_usage"),
     ("state_machine", "pull_cop_shift_m", "", "pull_cop_shift_m"),
     ("state_machine", "pad_forces_W", "", "pad_forces_W"),
     ("state_machine", "hand_wrenches_W", "", "hand_wrenches_W"),
     ("state_machine", "stand_up", "", "stand_up"),
+    ("state_machine", "sit_down", "", "sit_down"),
+    ("state_machine", "seat_pad_normal_forces_N", "", "seat_pad_normal_forces_N"),
     ("advancement", "com_W", "", "com_W"),
     ("advancement", "com_velocity_W", "", "com_velocity_W"),
     ("advancement", "omega_f_W", "", "omega_f_W"),
@@ -164,7 +167,11 @@ def _standup_systems(scenario: Scenario, station: Station, plan: StandupPlan) ->
     responses = responses_of(response_names(scenario.response))
     return {
         "state_machine": StandupStateMachine(
-            scenario.standup, table, len(station.pad_groups), station.sole_rows()
+            scenario.standup,
+            table,
+            len(station.pad_groups),
+            station.sole_rows(),
+            seat_top_z_m=scenario.chair.seat_top_z_m(),
         ),
         "advancement": TrajectoryAdvancement(
             for_robot(scenario.advancement, model.kinematics.nominal_mass_kg),

@@ -18,12 +18,12 @@ from pydrake.systems.framework import BasicVector, Context, LeafSystem, State
 from drake_standup.config import StandupConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.ports.payloads import SEGMENT
+from drake_standup.standup.sit_down import next_cycle_mode
 from drake_standup.standup.transitions import (
     N_STATES,
     Measurements,
     StandupMode,
     initial_mode,
-    next_mode,
 )
 
 
@@ -31,14 +31,17 @@ class StandupStateMachine(LeafSystem):
     """Periodic (standup.update_period_s) state machine with the mode as abstract state.
 
     Inputs: psi (1), com_W (3), heel_x_W (1), thigh_x_W (1; unconnected: never passed),
+    thigh_z_W (1; unconnected: the thighs' height above the seat unknown),
     standing_pull_usage and braced_pull_usage (1 each; unconnected: 0, and never braced),
     pull_cop_shift_m (1; unconnected: 0),
     pad_forces_W (3 per pad, rows of the soles
     given as sole_rows = (left, right)), hand_wrenches_W (12, payloads.HAND_WRENCHES), and
-    stand_up (1; > 0.5: go; unconnected: never), which only the live helper has.
-    Outputs: mode (abstract StandupMode), standup_state (1), advances (1: the phase lets
-    psi advance), segment (payloads.SEGMENT), entry_times_s (4, NaN for states not
-    reached), held_back (4: [a backward pull holds it (1/0), the time it has waited so
+    stand_up (1; > 0.5: go; unconnected: never) and sit_down (the same), which only the
+    live helper has, seat_pad_normal_forces_N (3; unconnected: the sit-down's pads never
+    touch).
+    Outputs: mode (abstract StandupMode), standup_state (1; 5-7: the sit-down), advances (1: the phase lets
+    psi advance), segment (payloads.SEGMENT), entry_times_s (4: the stand-up's states' last
+    entries, NaN for states not reached), held_back (4: [a backward pull holds it (1/0), the time it has waited so
     far, s, a pull beyond the standing feet holds it (1/0), the part of that time it did,
     s]).
     """
@@ -49,7 +52,12 @@ class StandupStateMachine(LeafSystem):
         table: PhaseTable,
         n_pads: int,
         sole_rows: tuple[int, int],
+        *,
+        seat_top_z_m: float = math.nan,
     ):
+        """seat_top_z_m: the seat's top (the chair's geometry), which the thighs' height
+        above it is measured from (NaN: not known, the sit-down's approach never ends
+        early)."""
         super().__init__()
         if table.unresolved_heights():
             raise ValueError(
@@ -58,19 +66,23 @@ class StandupStateMachine(LeafSystem):
             )
         self._cfg = config
         self._table = table
-        self._advances = [float(phase.advances) for phase in table]
+        self._advances = [float(phase.advances) for phase in table.every()]
         self._sole_rows = sole_rows
         self._mode_index = self.DeclareAbstractState(Value[object](StandupMode()))
         self._psi = self.DeclareVectorInputPort("psi", 1)
         self._com = self.DeclareVectorInputPort("com_W", 3)
         self._heel = self.DeclareVectorInputPort("heel_x_W", 1)
         self._thigh = self.DeclareVectorInputPort("thigh_x_W", 1)
+        self._thigh_z = self.DeclareVectorInputPort("thigh_z_W", 1)
+        self._seat_top_z = seat_top_z_m
         self._usage = self.DeclareVectorInputPort("standing_pull_usage", 1)
         self._braced_usage = self.DeclareVectorInputPort("braced_pull_usage", 1)
         self._cop_shift = self.DeclareVectorInputPort("pull_cop_shift_m", 1)
         self._pads = self.DeclareVectorInputPort("pad_forces_W", 3 * n_pads)
         self._hands = self.DeclareVectorInputPort("hand_wrenches_W", 12)
         self._stand_up = self.DeclareVectorInputPort("stand_up", 1)
+        self._sit_down = self.DeclareVectorInputPort("sit_down", 1)
+        self._seat = self.DeclareVectorInputPort("seat_pad_normal_forces_N", 3)
         self.DeclareInitializationUnrestrictedUpdateEvent(self._Initialize)
         self.DeclarePeriodicUnrestrictedUpdateEvent(config.update_period_s, 0.0, self._Update)
         mode_only = {self.abstract_state_ticket(self._mode_index)}
@@ -111,6 +123,13 @@ class StandupStateMachine(LeafSystem):
             hand_fx_N=(float(hands[0, 3]), float(hands[1, 3])),
             hand_fz_N=(float(hands[0, 5]), float(hands[1, 5])),
             stand_up=self._stand_up.HasValue(context) and self._stand_up.Eval(context)[0] > 0.5,
+            sit_down=self._sit_down.HasValue(context) and self._sit_down.Eval(context)[0] > 0.5,
+            thigh_gap_m=float(self._thigh_z.Eval(context)[0]) - self._seat_top_z
+            if self._thigh_z.HasValue(context)
+            else math.nan,
+            seat_fz_N=tuple(float(f) for f in self._seat.Eval(context))
+            if self._seat.HasValue(context)
+            else (math.nan,) * 3,
             pull_usage=float(self._usage.Eval(context)[0])
             if self._usage.HasValue(context)
             else 0.0,
@@ -123,7 +142,7 @@ class StandupStateMachine(LeafSystem):
         )
 
     def _Update(self, context: Context, state: State) -> None:
-        new = next_mode(self.mode(context), self._measure(context), self._cfg, self._table)
+        new = next_cycle_mode(self.mode(context), self._measure(context), self._cfg, self._table)
         state.get_mutable_abstract_state(self._mode_index).set_value(new)
 
     def _CalcMode(self, context: Context, output: Value) -> None:
@@ -154,4 +173,4 @@ class StandupStateMachine(LeafSystem):
         output.SetAtIndex(0, float(self.mode(context).guards.brace.on))
 
     def _CalcEntryTimes(self, context: Context, output: BasicVector) -> None:
-        output.SetFromVector(np.array(self.mode(context).entry_times_s))
+        output.SetFromVector(np.array(self.mode(context).entry_times_s[:N_STATES]))

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drake_standup.config import RESPONSES, ComplianceConfig, ControllerConfig
-from drake_standup.config.phases import PhaseTable
+from drake_standup.config.phases import PHASES, PhaseTable
 from drake_standup.config.responses import SHIPPED, Response
 from drake_standup.control.smooth import psi_clock_blend, smoothstep
 from drake_standup.control.targets import StateReferences, TaskReferences, joint_values
@@ -47,6 +47,7 @@ from drake_standup.control.tasks.posture import posture_acceleration_reference
 from drake_standup.control.terms import RobotTerms
 from drake_standup.robot.spatial import skew
 from drake_standup.standup.com_path import CoMTarget
+from drake_standup.standup.return_path import base_pitch, next_memory, returning, with_pitch
 
 # The response codes (the index in config.RESPONSES) the controller's systems read.
 ADVANCEMENT, STIFF, COMPLIANT = (RESPONSES.index(name) for name in RESPONSES)
@@ -64,6 +65,9 @@ class TickInputs:
     response: int = ADVANCEMENT  # ADVANCEMENT, STIFF or COMPLIANT (module docstring)
     psi_dot: float = 1.0  # the advancement's rate (the posture filter's clock)
     braced: bool = False  # the arms braced against a strong pull (PhaseReferences)
+    # How far along its sit-down phase's path the CoM reference is (sit_down.py
+    # descent_progress; NaN: not sitting down): the posture returns along with it.
+    descent_progress: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -90,7 +94,7 @@ class CarriedState:
 
 
 class PhaseReferences:
-    """StateReferences of states 1-4 from the phase table (phases.py), the arms reaching as
+    """StateReferences of states 1-7 from the phase table (phases.py), the arms reaching as
     the phases' postures have them or braced (arm_joints hold the first tick's posture,
     as the robot sat: standup.brace_arms)."""
 
@@ -112,8 +116,9 @@ class PhaseReferences:
         self.q_target_max = q_max - margin
         arms = np.isin(joint_names, list(arm_joints))
         self._by_state = {}
-        for state, phase in enumerate(table, start=1):
+        for state, phase in enumerate(table.every(), start=1):
             target = joint_values(joint_names, phase.posture_rad, "posture_rad")
+            returns = PHASES.index(phase.returns_to) + 1 if phase.returns_to else 0
             kp = np.array(phase.com_kp_per_s2)
             for braced in (False, True):
                 held = np.where(arms, np.nan, target) if braced else target
@@ -127,6 +132,8 @@ class PhaseReferences:
                     phase.lean,
                     phase.stance,
                     -braced_drop_m if braced and phase.lean else 0.0,
+                    returns,
+                    phase.stance_throughout,
                 )
 
     def __getitem__(self, key: int | tuple[int, bool]) -> StateReferences:
@@ -206,12 +213,21 @@ class TaskReferenceGenerator:
         stance = smoothstep(
             (path_progress - config.stance_from_progress) / (1.0 - config.stance_from_progress)
         )
+        if state.stance_throughout:
+            stance = 1.0
         return stance, 1.0 - stance * (1.0 - config.stance_vertical_weight_scale)
 
     def _posture(
-        self, terms: RobotTerms, state: StateReferences, posture: np.ndarray, psi_dot: float
-    ) -> tuple[np.ndarray, np.ndarray, float]:
-        """(q_ref this tick, the posture state after it, the first tick's base yaw): the
+        self,
+        terms: RobotTerms,
+        state: StateReferences,
+        posture: np.ndarray,
+        psi_dot: float,
+        now: TickInputs,
+    ) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """(q_ref this tick, the posture state after it, the first tick's base yaw, the base's
+        pitch target; a sit-down phase's posture and pitch return along the path,
+        return_path.py): the
         first tick latches the posture it finds (and the base's yaw). The filter runs on
         psi, never slower than time: the postures advance with the CoM path, as the
         paper's trajectory does (psi = t: as on time); on time, a rise at psi_dot 2.5
@@ -223,24 +239,38 @@ class TaskReferenceGenerator:
         if posture[0] > 0.5:
             q_initial = posture[1 : 1 + nu]
             q_reference, q_stage = posture[1 + nu : 1 + 2 * nu], posture[1 + 2 * nu : 1 + 3 * nu]
-            base_yaw = posture[-1]
+            base_yaw = posture[1 + 3 * nu]
         else:
             q_initial = q_reference = q_stage = terms.q[self._q_joints]
             base_yaw = math.atan2(terms.R_WB[1, 0], terms.R_WB[0, 0])
+        memory = next_memory(
+            posture[2 + 3 * nu :] if posture[0] > 0.5 else None,
+            now.standup_state,
+            q_reference,
+            terms.q[self._q_joints],
+            base_pitch(terms.R_WB),
+        )
+        target, hold, pitch = state.posture_rad, state.posture_hold, state.base_pitch_rad
+        if state.posture_returns_to:
+            target, pitch = returning(memory, nu, state.posture_returns_to, now.descent_progress)
+            hold = np.zeros_like(state.posture_hold)
+        memory = with_pitch(memory, nu, pitch)
         two_stages = self._config.posture_filter_stages == 2
         # The stage that follows the state's posture: the first of two, or q_ref itself.
         q_stage_next = next_posture_reference(
             q_initial,
             q_stage if two_stages else q_reference,
-            state.posture_hold,
-            state.posture_rad,
+            hold,
+            target,
             self.phases.q_target_min,
             self.phases.q_target_max,
             blend=blend,
         )
         q_next = q_reference + blend * (q_stage - q_reference) if two_stages else q_stage_next
-        next_posture = np.concatenate((self._latched, q_initial, q_next, q_stage_next, (base_yaw,)))
-        return q_reference, next_posture, base_yaw
+        next_posture = np.concatenate(
+            (self._latched, q_initial, q_next, q_stage_next, (base_yaw,), memory)
+        )
+        return q_reference, next_posture, base_yaw, pitch
 
     def calc(self, terms: RobotTerms, now: TickInputs, carried: CarriedState) -> TaskReferences:
         """This tick's references from the robot's terms, what the tick reads now and what
@@ -262,7 +292,9 @@ class TaskReferenceGenerator:
         )
         stance, vertical_weight_scale = self._stance(state, now.path_progress)
         helped = F_hand_W is not None and self._responses[response].lets_help_through
-        q_reference, next_posture, base_yaw = self._posture(terms, state, carried.posture, psi_dot)
+        q_reference, next_posture, base_yaw, pitch = self._posture(
+            terms, state, carried.posture, psi_dot, now
+        )
         momentum = self.momentum.target(
             terms,
             com_target,
@@ -281,7 +313,7 @@ class TaskReferenceGenerator:
             Ldot_star=momentum.Ldot_star,
             tau_hand=tau_hand,
             q_reference=q_reference,
-            R_WB_target=self.base_target(base_yaw, state.base_pitch_rad),
+            R_WB_target=self.base_target(base_yaw, pitch),
             helpful_force_W=momentum.helpful_force_W,
             lean_W=lean,
             vertical_weight_scale=vertical_weight_scale,

@@ -31,7 +31,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from drake_standup.config import StandupConfig
-from drake_standup.config.phases import SEAT_PAD_ROWS, SEAT_PADS, Guard, Phase, PhaseTable
+from drake_standup.config.phases import (
+    EVERY_PHASE,
+    SEAT_PAD_ROWS,
+    SEAT_PADS,
+    Guard,
+    Phase,
+    PhaseTable,
+)
 from drake_standup.control.smooth import smoothstep
 from drake_standup.standup.com_path import reference_at
 from drake_standup.standup.guards import (  # noqa: F401 (the mode's parts, re-exported)
@@ -43,6 +50,8 @@ from drake_standup.standup.guards import (  # noqa: F401 (the mode's parts, re-e
 )
 
 _NAN3 = (math.nan, math.nan, math.nan)
+# The states a run can be in: the stand-up's (1-4) and the sit-down's (5-7).
+N_MODES = len(EVERY_PHASE)
 
 
 @dataclass(frozen=True)
@@ -51,7 +60,8 @@ class StandupMode:
     filtered signals, and what a pull against the stand-up has done."""
 
     state: int = 1
-    entry_times_s: tuple[float, ...] = (0.0,) + (math.nan,) * (N_STATES - 1)
+    # When each state (1-7) was last entered (NaN: not yet).
+    entry_times_s: tuple[float, ...] = (0.0,) + (math.nan,) * (N_MODES - 1)
     psi_entry: float = 0.0
     segment_psi: float = 1.0
     x_start_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -72,6 +82,17 @@ class StandupMode:
     sat_back: bool = False  # a hindering pull has sat the robot back since the start
     # When the release of each seat pad group (phases.SEAT_PADS) began (NaN: seated).
     release_s: tuple[float, ...] = (math.nan,) * len(SEAT_PADS)
+    # Where each stand-up state's segment last started: the sit-down returns along them.
+    starts_m: tuple[tuple[float, float, float], ...] = (_NAN3,) * N_STATES
+    # When each seat pad group touched the seat in the sit-down that lands it (NaN: not).
+    land_s: tuple[float, ...] = (math.nan,) * len(SEAT_PADS)
+    sit_downs: int = 0  # sit-downs completed (back in state 1)
+    standing_since_s: float = math.nan  # state 4's segment done since (NaN: not)
+    # Where the reference was when the sit-down's phase began (its path's start; a hold
+    # keeps it): how far along that path the CoM reference is moves the posture.
+    phase_from_m: tuple[float, float, float] = _NAN3
+    phase_to_m: tuple[float, float, float] = _NAN3  # ... and where it ends
+    creeping: bool = False  # the phase's path done, creeping down to the seat's touch
 
     def __copy__(self) -> StandupMode:
         return self
@@ -109,8 +130,9 @@ class StandupMode:
 def initial_mode(com0_W: np.ndarray, t: float = 0.0) -> StandupMode:
     """State 1 at t, holding the CoM where it starts."""
     com0 = tuple(float(c) for c in com0_W)
-    entry = (t,) + (math.nan,) * (N_STATES - 1)
-    return StandupMode(entry_times_s=entry, x_start_m=com0, x_seated_m=com0)
+    entry = (t,) + (math.nan,) * (N_MODES - 1)
+    starts = (com0,) + (_NAN3,) * (N_STATES - 1)
+    return StandupMode(entry_times_s=entry, x_start_m=com0, x_seated_m=com0, starts_m=starts)
 
 
 def next_mode(
@@ -182,7 +204,9 @@ def guard_holds(phase: Phase, mode: StandupMode, m: Measurements, cfg: StandupCo
     k = mode.state - 1
     dwell = m.t - mode.entry_times_s[k]
     g = mode.guards
-    if dwell < guard.min_time_s:
+    # Seated again after a sit-down, the robot balances sit_down.seated_s.
+    min_time_s = cfg.sit_down.seated_s if k == 0 and mode.sit_downs else guard.min_time_s
+    if dwell < min_time_s:
         return False
     pulled = g.hands_pulled.on or g.hands_held.on
     if guard.asked and not (cfg.trigger == "time" or pulled or m.stand_up):
@@ -216,7 +240,7 @@ def _sit_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupM
     the reference is" is the one used: its height the CoM's where the segment followed
     it; the return holds its own height (height_follows off)."""
     x_now = mode.reference(m.psi, m.com_W)
-    entry = [m.t] + [math.nan] * (N_STATES - 1)
+    entry = [m.t] + [math.nan] * (N_MODES - 1)
     return dataclasses.replace(
         mode,
         state=1,
@@ -281,10 +305,13 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
         delta[:2] = np.array(mode.resume_end_m[:2]) - x_start[:2]
     entry = list(mode.entry_times_s)
     entry[state - 1] = m.t
+    starts = list(mode.starts_m)
+    starts[state - 1] = tuple(float(v) for v in x_start)
     entered = dataclasses.replace(
         mode,
         state=state,
         entry_times_s=tuple(entry),
+        starts_m=tuple(starts),
         psi_entry=m.psi,
         segment_psi=phase.segment_psi,
         x_start_m=tuple(float(v) for v in x_start),
@@ -311,19 +338,42 @@ def seat_releases(table: PhaseTable) -> list[tuple[int, float, list[int], int]]:
     return releases
 
 
+def seat_landings(table: PhaseTable) -> list[tuple[int, float, list[int], int]]:
+    """seat_releases' entries for the pad groups a sit-down phase lands (phase.load)."""
+    landings = []
+    for k, pads in enumerate(SEAT_PADS):
+        state = table.landing_phase(pads)
+        if state is not None:
+            rows = [i for i, name in enumerate(SEAT_LOADS) if name == pads]
+            landings.append((state, table.phase(state).load_s, rows, k))
+    return landings
+
+
 def seat_loads(
-    mode: StandupMode, t: float, table: PhaseTable | list[tuple[int, float, list[int]]]
+    mode: StandupMode,
+    t: float,
+    table: PhaseTable | list[tuple[int, float, list[int]]],
+    landings: list[tuple[int, float, list[int], int]] = (),
 ) -> np.ndarray:
     """What is left of the load of the buttocks and of each thigh (SEAT_LOADS), as a
     fraction of their load when their release began; NaN while the pad is seated. A pad
     group is released from mode.release_s (in the phase that lists it in unload, at its
     entry or once its unload_when holds; until the robot is back in an earlier phase),
-    smoothstep from 1 to 0 over its unload_s. table: the phase table, or its
-    seat_releases."""
+    smoothstep from 1 to 0 over its unload_s; in a sit-down, from its touch (mode.land_s)
+    from 0 to 1 over the landing phase's load_s, then seated. table: the phase table, or
+    its seat_releases; landings: seat_landings(table), none by default."""
     releases = seat_releases(table) if isinstance(table, PhaseTable) else table
     loads = np.full(len(SEAT_LOADS), math.nan)
     for _, over_s, rows, k in releases:
         began = mode.release_s[k]
         if not math.isnan(began):
             loads[rows] = 0.0 if over_s <= 0 else smoothstep(1.0 - (t - began) / over_s)
+    # A sit-down's landing pads (seat_landings): from their touch their load rises back
+    # to what it was when their release began, over the phase's load_s; seated then.
+    for _, over_s, rows, k in landings:
+        landed_for = t - mode.land_s[k]
+        if landed_for < over_s:
+            loads[rows] = smoothstep(landed_for / over_s)
+        elif landed_for >= over_s:
+            loads[rows] = math.nan
     return loads

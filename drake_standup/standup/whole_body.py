@@ -41,6 +41,8 @@ from drake_standup.control.model import ControllerModel
 from drake_standup.ports.payloads import COM_REFERENCE, HAND_WRENCHES
 from drake_standup.standup.contact_schedule import ContactSchedule
 from drake_standup.standup.task_references import CarriedState, TaskReferenceGenerator, TickInputs
+from drake_standup.standup.return_path import memory_size
+from drake_standup.standup.sit_down import descent_progress
 from drake_standup.standup.transitions import StandupMode
 
 _COMMANDED = DIAGNOSTICS["commanded_normal_force_N"]
@@ -81,8 +83,8 @@ class StandupWholeBodyController(LeafSystem):
         self._weighing = self.DeclareDiscreteState(np.array(ControllerModel.INITIAL_WEIGHING))
         self._integral = self.DeclareDiscreteState(3)
         # [latched flag, state-1 posture (nu), filtered posture reference (nu), the
-        # filter's first stage (nu), base yaw].
-        self._posture = self.DeclareDiscreteState(2 + 3 * nu)
+        # filter's first stage (nu), base yaw, the sit-down's memory (return_path.py)].
+        self._posture = self.DeclareDiscreteState(2 + 3 * nu + memory_size(nu))
         self._lean = self.DeclareDiscreteState(3)
         self._height_integral = self.DeclareDiscreteState(1)
         self._compliance = self.DeclareDiscreteState(6)
@@ -153,6 +155,9 @@ class StandupWholeBodyController(LeafSystem):
                 response=int(round(self._input("response", context)[0])),
                 psi_dot=self._psi_dot(context),
                 braced=mode.guards.brace.on,
+                descent_progress=descent_progress(
+                    mode, self._input("com_reference", context)[:3], self._schedule.table
+                ),
             ),
             CarriedState(
                 momentum_integral=state.get_value(self._integral),

@@ -141,8 +141,10 @@ class RobotSensing(LeafSystem):
 
     Outputs com_W (3, m), com_velocity_W (3, m/s), omega_f_W (3, m/s^2),
     heel_x_W (1, m: the front-most of the two soles' heel edges, so "CoM ahead
-    of the heels" holds for both feet) and thigh_x_W (1, m: the mean x of the
-    thigh pads' centres, where the seat's support ends; NaN without pads),
+    of the heels" holds for both feet), thigh_x_W (1, m: the mean x of the
+    thigh pads' centres, where the seat's support ends; NaN without pads) and thigh_z_W
+    (1, m: the lower of the thigh pads' undersides' centres, how near the seat they are;
+    NaN without pads),
     hand_positions_W and hand_velocities_W (6 each, m and m/s: the left and the right
     hand frame's origin, where a pull is applied, helper.hands.hand_forces; what the helper's
     work is summed over, helper.work.HelperWork), pull_cop_shift_m (1, m: pull_cop_shift_m of
@@ -197,6 +199,9 @@ class RobotSensing(LeafSystem):
         )
         self.DeclareVectorOutputPort(
             "thigh_x_W", 1, self._CalcThighX, prerequisites_of_calc=state_only
+        )
+        self.DeclareVectorOutputPort(
+            "thigh_z_W", 1, self._CalcThighZ, prerequisites_of_calc=state_only
         )
         self.DeclareVectorOutputPort(
             "omega_f_W", 3, self._CalcOmegaF, prerequisites_of_calc={self._wrenches.ticket()}
@@ -272,6 +277,10 @@ class RobotSensing(LeafSystem):
     def _CalcThighX(self, context: Context, output: BasicVector) -> None:
         xs = self._points_x(context, self._thighs)
         output.SetAtIndex(0, float(np.mean(xs)) if xs else np.nan)
+
+    def _CalcThighZ(self, context: Context, output: BasicVector) -> None:
+        zs = [float(p[2]) for p in self._points(context, self._thighs)]
+        output.SetAtIndex(0, min(zs) if zs else np.nan)
 
     def _CalcHandPositions(self, context: Context, output: BasicVector) -> None:
         self._set_plant_state(context, check=True)
