@@ -168,6 +168,8 @@ class Phase:
     # carried before their release, over load_s (smoothstep). s.
     returns_to: str | None = None
     posture_as: str | None = None
+    # ... the trunk (the torso's joints and the pelvis' pitch) this many times as fast.
+    trunk_leads_by: float = 1.0
     # Its path done with a pad it lands not yet touching the seat, the reference creeps
     # this much lower (over load_s) until the touch; from the touch the reference's
     # height follows the CoM (the seat takes it). m.

@@ -19,6 +19,7 @@ from pydrake.systems.analysis import GetIntegrationSchemes
 from drake_standup.config.body import TONES
 from drake_standup.config.chair import SEAT_BOARD_M, ChairConfig
 from drake_standup.config.controller import MODEL_LIBRARIES, MOMENTUM_INTEGRAL_AXES, QP_SOLVERS
+from drake_standup.config.cycle import SIT_DOWN_TRIGGERS, check_sit_down
 from drake_standup.config.errors import ScenarioError
 from drake_standup.config.hardware import HARDWARE
 from drake_standup.config.inputs import ModelNames, check_chair_file, check_robot_model
@@ -30,7 +31,7 @@ from drake_standup.config.phases import (
     WHEN_HINDERED,
 )
 from drake_standup.config.recording import FRAMES, load_recording
-from drake_standup.config.scenario import REFLECTED_INERTIA, SIT_DOWN_TRIGGERS, Scenario
+from drake_standup.config.scenario import REFLECTED_INERTIA, Scenario
 
 
 @dataclass(frozen=True)
@@ -90,7 +91,10 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (PLANT_STEP, "hardware.plant_time_step_s"),
     (("hands", "time"), "standup.trigger"),
     (SIT_DOWN_TRIGGERS, "standup.sit_down.trigger"),
-    (Range(low=1.0, high=100.0, text="a whole number 1-100", integer=True), "standup.sit_down.times"),
+    (
+        Range(low=1.0, high=100.0, text="a whole number 1-100", integer=True),
+        "standup.sit_down.times",
+    ),
     (RETURNS_TO, "phases.*.returns_to"),
     (PHASES, "phases.*.posture_as"),
     (SEAT_PADS, "phases.*.load[*]"),
@@ -133,7 +137,10 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
         "human.reactive.damping_Ns_per_m human.reactive.travel_m "
         "human.reactive.path_corner_radius_m human.reactive.lead_min_m "
         "human.reactive.ease_com_rise_m advancement.alpha_*_mps2 advancement.lag_tolerance_m "
-        "standup.*_s standup.*_N standup.sit_down.*_s standup.sit_down.*_N phases.*.unload_s phases.*.load_s phases.*.exit.* phases.*.com_kp_per_s2 "
+        "standup.*_s standup.*_N standup.sit_down.stand_s standup.sit_down.seated_s "
+        "standup.sit_down.at_s standup.sit_down.touch_gap_m "
+        "standup.sit_down.*_N phases.*.unload_s phases.*.load_s phases.*.sink_m "
+        "phases.*.trunk_leads_by phases.*.exit.* phases.*.com_kp_per_s2 "
         "controller.*_weight controller.*_weight_s controller.contact_velocity_gain_per_s "
         "controller.*weight_by_joint.* controller.*_kp_* controller.*_kd_* controller.*_ki_* "
         "controller.*_damping_ratio controller.posture_limit_margin_rad controller.*_N "
@@ -336,6 +343,7 @@ def _check_across_fields(scenario: Scenario) -> None:
             f"({step}), e.g. {step} or {2 * step}"
         )
     _check_cushion(scenario.chair)
+    check_sit_down(scenario)
     for i, pull in enumerate(scenario.human.pulls):
         if 2 * pull.ramp_s > pull.duration_s:
             raise ScenarioError(

@@ -12,6 +12,7 @@ from pydrake.systems.analysis import SimulatorConfig
 from drake_standup.config.body import BodyHelperConfig
 from drake_standup.config.chair import ChairConfig, InitialPose
 from drake_standup.config.controller import ControllerConfig
+from drake_standup.config.cycle import SitDownConfig
 from drake_standup.config.hardware import HardwareConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.config.recording import RecordedHelperConfig
@@ -228,31 +229,6 @@ class ComplianceConfig:
     # and the 8.2 cm to the heels (issue 21, docs/results.md); sideways and up or down
     # 3 cm. m.
     max_offset_m: list[float] = field(default_factory=lambda: [0.04, 0.03, 0.03])
-
-
-# What starts a sit-down from standing (standup.sit_down.trigger): none (the robot stays
-# up), hands (the helper's pull back and down, or the live page's Sit down button),
-# time (standing stand_s).
-SIT_DOWN_TRIGGERS = ("none", "hands", "time")
-
-
-@dataclass
-class SitDownConfig:
-    """The sit-down after standing (states 5-7, phases.DESCENT), and standing again."""
-
-    trigger: str = "none"
-    # Standing this long (the rise's segment done) before the clock sits the robot down;
-    # the hands' and the button's sit-down waits for standup.resume_after_s of standing. s.
-    stand_s: float = 3.0
-    # Seated again, the robot balances this long before a stand-up may be asked again
-    # (the seated phase's min_time_s is the first stand-up's). s.
-    seated_s: float = 2.0
-    # How many sit-downs a run makes at most.
-    times: int = 1
-    # A pad group has touched the seat once its pads' filtered normal force exceeds this
-    # (the metrics' unloading level is 5 N: above the 1-3 N a compliant pad feels while
-    # the thigh brushes it). N.
-    touch_force_N: float = 10.0
 
 
 @dataclass

@@ -39,6 +39,8 @@ class StateReferences:
     posture_returns_to: int = 0
     # The stance acts over the whole segment, not only its end.
     stance_throughout: bool = False
+    # A sit-down phase's trunk returns this many times as fast along the path.
+    trunk_leads_by: float = 1.0
 
 
 @dataclass(slots=True)

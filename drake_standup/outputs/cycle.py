@@ -1,12 +1,22 @@
-"""The sit-down's metrics (issue 62) from a run's signals: each sit-down's time, how its
-thighs landed, how the CoM tracked the descent, and whether the robot stood again.
+"""The sit-down's metrics (issue 62) from a run's signals: each sit-down's time, how it
+landed, how the CoM tracked the descent, the soles' chatter on the way down, and whether
+the robot stood again.
 
 A sit-down runs from state 5's entry (lower) to state 1's (seated, the buttocks landed).
-Its landing is judged on the seat pads' force, each sample the mean over the log period
-before it (the plant's impulse: signals.group_mean_normal_forces), from state 6's entry
-(land) to landing_window_s after seated; the load the pads settle at is their mean over
-the last settle_window_s of the seated stay (before the next stand-up's state 2, or the
-run's end).
+Forces are each sample's mean over the log period before it (the plant's impulse:
+signals.group_mean_normal_forces).
+- The landing (landing_peak_ratio): the seat pads' force (thighs and buttocks) from state
+  6's entry (land) to landing_window_s after seated, its peak over the load the pads
+  settle at (their mean over the last settle_window_s of the seated stay, before the next
+  stand-up's state 2 or the run's end). The seat as a whole: how the load shares between
+  thighs and buttocks is the seat's geometry's (on a 0.18 m seat the thighs slope up off
+  it and settle at nearly nothing).
+- The thighs' own landing (thighs_landing_peak_ratio): their peak in state 6 over their
+  load at its end (the last 0.1 s).
+- seat_load_rate_N_per_s, soles_unload_rate_N_per_s: the seat's fastest rise and the
+  soles' fastest fall over 50 ms in the landing's window.
+- sit_down_sole_chatter_N: metrics.smoothness_metrics' chatter over the sit-down (state
+  5's entry to landing_window_s after seated).
 """
 
 from __future__ import annotations
@@ -14,6 +24,17 @@ from __future__ import annotations
 import numpy as np
 
 from drake_standup.outputs.signals import group_mean_normal_forces
+
+
+def moving_average_departure(x: np.ndarray, window: int) -> np.ndarray:
+    """|x - its centred moving average over window samples (odd)| where the window is
+    full (metrics.py's, here to keep the import one way)."""
+    half = window // 2
+    if len(x) < window:
+        return np.zeros(0)
+    mean = np.convolve(x, np.ones(window) / window, mode="valid")
+    return np.abs(x[half : len(x) - half] - mean)
+
 
 # The sit-down's states (standup/sit_down.py): lower, land, settle; seated is state 1.
 LOWER, LAND, SEATED = 5, 6, 1
@@ -71,30 +92,48 @@ def _one_sit_down(signals: dict, start: int, *, landing_window_s: float, settle_
     i_land = land[0] if len(land) else i_seated
     window = (np.arange(len(t)) >= i_land) & (t <= t[i_seated] + landing_window_s)
     window &= np.arange(len(t)) < stay_end
-    settled_thighs, settled_seat = float(thighs[stay].mean()), float(seat[stay].mean())
+    settled_seat = float(seat[stay].mean())
+    own = (np.arange(len(t)) >= i_land) & (state == LAND)
+    own_end = own & (t >= t[own].max() - 0.1) if own.any() else own
+    landed = float(thighs[own_end].mean()) if own.any() else float("nan")
     record |= {
-        "thighs_landing_peak_N": float(thighs[window].max()),
-        "thighs_seated_N": settled_thighs,
-        "thighs_landing_peak_ratio": float(thighs[window].max() / max(settled_thighs, 1e-9)),
-        "seat_landing_peak_N": float(seat[window].max()),
-        "seat_seated_N": settled_seat,
-        "seat_landing_peak_ratio": float(seat[window].max() / max(settled_seat, 1e-9)),
+        "landing_peak_N": float(seat[window].max()),
+        "seated_load_N": settled_seat,
+        "landing_peak_ratio": float(seat[window].max() / max(settled_seat, 1e-9)),
+        "thighs_landing_peak_N": float(thighs[own].max()) if own.any() else None,
+        "thighs_landed_N": landed,
+        "thighs_landing_peak_ratio": float(thighs[own].max() / max(landed, 1e-9))
+        if own.any()
+        else None,
+        "seated_normal_force_N": {g: float(f[stay].mean()) for g, f in forces.items()},
         "seat_load_rate_N_per_s": _rate_N_per_s(seat[window], t[window], 0.05),
         "soles_unload_rate_N_per_s": _rate_N_per_s(
             -forces.get("soles", np.zeros(len(t)))[window], t[window], 0.05
         ),
         "stood_again": bool(len(again)) and bool(np.any(state[again[0] :] == STAND_UP_STATES)),
+        "sit_down_sole_chatter_N": _chatter(forces.get("soles"), t, start, window),
     }
     return record
+
+
+def _chatter(soles: np.ndarray | None, t: np.ndarray, start: int, window: np.ndarray):
+    """The soles' chatter (metrics.moving_average_departure over 0.1 s) from start to the
+    landing window's end."""
+    if soles is None or len(t) < 2:
+        return None
+    n = int(round(0.1 / float(np.median(np.diff(t))))) | 1
+    departure = moving_average_departure(soles, n)
+    centre = np.arange(n // 2, len(t) - n // 2)
+    last = int(np.flatnonzero(window)[-1]) if window.any() else len(t) - 1
+    inside = (centre >= start) & (centre <= last)
+    return float(departure[inside].max()) if inside.any() else None
 
 
 def sit_down_metrics(
     signals: dict[str, np.ndarray], *, landing_window_s: float = 1.0, settle_window_s: float = 0.5
 ) -> dict:
     """{} where the run never sat down; else sit_downs (one record a sit-down, as the
-    module docstring measures it) and the first's figures at the top level:
-    sit_down_time_s, thighs_landing_peak_N and _ratio, seat_load_rate_N_per_s,
-    descent_com_tracking_rms_m."""
+    module docstring measures it) and the first's figures at the top level (keys)."""
     state = np.asarray(signals["state"])
     if len(state) < 2 or not np.any(state == LOWER):
         return {}
@@ -108,10 +147,11 @@ def sit_down_metrics(
     first = records[0]
     keys = (
         "sit_down_time_s",
-        "thighs_landing_peak_N",
+        "landing_peak_N",
+        "landing_peak_ratio",
         "thighs_landing_peak_ratio",
-        "seat_landing_peak_ratio",
         "seat_load_rate_N_per_s",
         "descent_com_tracking_rms_m",
+        "sit_down_sole_chatter_N",
     )
     return {"sit_downs": records} | {key: first.get(key) for key in keys}

@@ -11,6 +11,8 @@ from drake_standup.outputs.signals import group_mean_normal_forces
 from drake_standup.robot.limbs import JOINT_GROUPS, joint_group
 
 STATE_COLORS = {2: "tab:orange", 3: "tab:green", 4: "tab:purple"}
+# The sit-down's states (standup/sit_down.py), shaded over their spans.
+DESCENT_STATES = {5: ("lower", "tab:brown"), 6: ("land", "tab:pink"), 7: ("settle", "tab:olive")}
 
 
 def _plt():
@@ -28,6 +30,26 @@ def _mark_states(ax, entry_times_s, label: bool = False) -> None:
             ax.axvline(
                 t, color=STATE_COLORS[k], ls=":", lw=1.2, label=f"state {k}" if label else None
             )
+
+
+def _mark_cycle(ax, signals: dict[str, np.ndarray], label: bool = False) -> None:
+    """A cycle's later states (the sit-downs, shaded, and the stand-ups after them, as
+    lines) from the state's samples; nothing where the run never sat down."""
+    state, t = signals.get("state"), signals["time_s"]
+    if state is None or not np.any(state > max(STATE_COLORS)):
+        return
+    begins = np.r_[0, np.flatnonzero(np.diff(state)) + 1]
+    ends = np.r_[begins[1:], len(t) - 1]
+    seen, first_down = set(), float(t[np.argmax(state > max(STATE_COLORS))])
+    for i, j in zip(begins, ends, strict=True):
+        k = int(state[i])
+        tag = label and k not in seen
+        seen.add(k)
+        if k in DESCENT_STATES:
+            name, color = DESCENT_STATES[k]
+            ax.axvspan(t[i], t[j], color=color, alpha=0.15, lw=0, label=name if tag else None)
+        elif k in STATE_COLORS and t[i] > first_down:
+            ax.axvline(t[i], color=STATE_COLORS[k], ls=":", lw=1.2)
 
 
 def figure_advancement(
@@ -130,6 +152,7 @@ def figure_tracking(signals: dict[str, np.ndarray], entry_times_s, path: Path) -
     ax_v.set_xlabel("time [s]")
     for ax in (ax_x, ax_z, ax_f, ax_v):
         _mark_states(ax, entry_times_s, label=ax is ax_x)
+        _mark_cycle(ax, signals, label=ax is ax_x)
         ax.grid(alpha=0.3)
     ax_x.legend(fontsize=8)
     fig.tight_layout()

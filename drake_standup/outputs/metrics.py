@@ -6,7 +6,11 @@ from __future__ import annotations
 import numpy as np
 
 from drake_standup.helper.work import HELPER_SPENT
-from drake_standup.outputs.cycle import first_entry_times, sit_down_metrics
+from drake_standup.outputs.cycle import (
+    first_entry_times,
+    moving_average_departure,
+    sit_down_metrics,
+)
 from drake_standup.outputs.estimation import estimation_metrics
 from drake_standup.outputs.signals import group_mean_normal_forces, group_normal_forces
 from drake_standup.robot.limbs import (
@@ -211,16 +215,6 @@ def path_deviation_max_m(points_W: np.ndarray, path_W: np.ndarray) -> float | No
         d = np.linalg.norm(chunk[:, None, :] - nearest, axis=2).min(axis=1)
         worst = max(worst, float(d.max()))
     return worst
-
-
-def moving_average_departure(x: np.ndarray, window: int) -> np.ndarray:
-    """|x - its centred moving average over window samples (odd)| at each sample with a
-    full window (the first and last window // 2 samples have none)."""
-    half = window // 2
-    if len(x) < window:
-        return np.zeros(0)
-    mean = np.convolve(x, np.ones(window) / window, mode="valid")
-    return np.abs(x[half : len(x) - half] - mean)
 
 
 def standup_start_s(entry_times_s) -> float | None:

@@ -34,8 +34,12 @@ def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """Reads a binary or ASCII STL; returns (vertices (N, 3), faces (M, 3)).
 
     Coincident corners are merged so the mesh is indexed, which both shrinks
-    the OBJ and lets the decimator see the connectivity.
+    the OBJ and lets the decimator see the connectivity. A mesh that is no STL (the
+    COLLADA visuals of iCubGenova03) has no triangles here: its link keeps an empty
+    visual, as the reader before the one STL reader left it.
     """
+    if Path(path).suffix.lower() != ".stl":
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=int)
     corners, _ = read_stl_file(Path(path).read_bytes())  # three corners a triangle
     vertices, inverse = np.unique(corners, axis=0, return_inverse=True)
     faces = inverse.reshape(-1, 3)

@@ -60,6 +60,7 @@ TOGETHER = "both hands"
 # The response switch: 0, 1, 2 in the order of config.RESPONSES (15 characters).
 RESPONSE = "adv/stiff/compl"
 STAND_UP = "Stand up"
+SIT_DOWN = "Sit down"
 RESET = "Reset"
 STOP = "Stop"
 # Slider resolution. N.
@@ -93,14 +94,15 @@ def gamepad_pull(axes: list[float], cap_N: float) -> np.ndarray:
 
 class LiveHumanSource(LeafSystem):
     """The helper at the Meshcat page: HumanWrenchSource's ports (input robot_state,
-    unused; outputs hand_wrenches_W and spatial_forces) plus stand_up (1: the "Stand
-    up" button was pressed since the last reset) and response (1: the response switch's
-    code, RESPONSES' index; starts at response).
+    unused; outputs hand_wrenches_W and spatial_forces) plus stand_up (1: how often the
+    "Stand up" button was pressed since the last reset, at least 1 once the gamepad's start
+    button was), response (1: the response switch's code, RESPONSES' index; starts at
+    response) and sit_down (1: how often the "Sit down" button was pressed since then).
 
     Every period_s (the plant's step) a discrete update reads the page (sliders, the
-    switches, the gamepad, the button) into the state [f_left (3), f_right (3),
-    stand_up, response], world frame, N: so the pull reaches the plant within a step,
-    and the run's signals hold what the helper did.
+    switches, the gamepad, the buttons) into the state [f_left (3), f_right (3),
+    stand_up, response, sit_down], world frame, N: so the pull reaches the plant within a
+    step, and the run's signals hold what the helper did.
     """
 
     def __init__(
@@ -112,6 +114,7 @@ class LiveHumanSource(LeafSystem):
         period_s: float,
         stand_up_button: bool = True,
         *,
+        sit_down_button: bool = False,
         response: int = 0,
         responses: tuple[str, ...] = RESPONSES,
     ):
@@ -120,11 +123,13 @@ class LiveHumanSource(LeafSystem):
         self._meshcat = meshcat
         self._cap = config.reactive.force_cap_N
         self._stand_up_button = stand_up_button
+        self._sit_down_button = sit_down_button
         self._clicks_seen = 0
+        self._sit_clicks_seen = 0
         self._applied = hand_forces(plant, robot)
         self.DeclareVectorInputPort("robot_state", plant.num_multibody_states(robot.model_instance))
         self._response = response
-        self._index = self.DeclareDiscreteState(np.r_[np.zeros(7), float(response)])
+        self._index = self.DeclareDiscreteState(np.r_[np.zeros(7), float(response), 0.0])
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._Update)
         state = {self.discrete_state_ticket(self._index)}
         self.DeclareVectorOutputPort(
@@ -138,6 +143,7 @@ class LiveHumanSource(LeafSystem):
         )
         self.DeclareVectorOutputPort("stand_up", 1, self._CalcStandUp, prerequisites_of_calc=state)
         self.DeclareVectorOutputPort("response", 1, self._CalcResponse, prerequisites_of_calc=state)
+        self.DeclareVectorOutputPort("sit_down", 1, self._CalcSitDown, prerequisites_of_calc=state)
         self._add_controls()
 
     def _add_controls(self) -> None:
@@ -148,11 +154,15 @@ class LiveHumanSource(LeafSystem):
         m.AddSlider(RESPONSE, 0.0, len(self._responses) - 1.0, 1.0, float(self._response))
         if self._stand_up_button:
             m.AddButton(STAND_UP)
+        if self._sit_down_button:
+            m.AddButton(SIT_DOWN)
 
     def forget_clicks(self) -> None:
-        """Stand-up clicks so far no longer count (after a reset)."""
+        """Stand-up and sit-down clicks so far no longer count (after a reset)."""
         if self._stand_up_button:
             self._clicks_seen = self._meshcat.GetButtonClicks(STAND_UP)
+        if self._sit_down_button:
+            self._sit_clicks_seen = self._meshcat.GetButtonClicks(SIT_DOWN)
 
     def read_page(self) -> tuple[np.ndarray, bool]:
         """(2, 3) world pull on the left and right hand, N, and whether the stand-up
@@ -194,11 +204,20 @@ class LiveHumanSource(LeafSystem):
 
     def _Update(self, context: Context, discrete_state: DiscreteValues) -> None:
         forces, asked = self.read_page()
-        latched = context.get_discrete_state(self._index).GetAtIndex(6) > 0.5
+        last = context.get_discrete_state(self._index).value()
+        # How many times each was asked for since the reset: the state machine takes the
+        # k-th stand-up (after k - 1 sit-downs) and the k-th sit-down from the k-th click.
+        stand_ups = max(last[6], float(asked), self._clicks(STAND_UP, self._clicks_seen))
+        sit_downs = max(last[8], self._clicks(SIT_DOWN, self._sit_clicks_seen))
         discrete_state.set_value(
             self._index,
-            np.r_[forces.ravel(), float(latched or asked), float(self.read_response())],
+            np.r_[forces.ravel(), stand_ups, float(self.read_response()), sit_downs],
         )
+
+    def _clicks(self, button: str, seen: int) -> float:
+        """The button's clicks since the last reset (0 where the page has no such button)."""
+        shown = self._stand_up_button if button == STAND_UP else self._sit_down_button
+        return float(self._meshcat.GetButtonClicks(button) - seen) if shown else 0.0
 
     def _state(self, context: Context) -> np.ndarray:
         return context.get_discrete_state(self._index).value()
@@ -219,6 +238,9 @@ class LiveHumanSource(LeafSystem):
 
     def _CalcResponse(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, self._state(context)[7])
+
+    def _CalcSitDown(self, context: Context, output: BasicVector) -> None:
+        output.SetAtIndex(0, self._state(context)[8])
 
 
 def make_live_meshcat() -> Meshcat:
@@ -264,6 +286,7 @@ class LiveSession:
             self.meshcat,
             step,
             stand_up_button=self._scenario.standup.trigger == "hands",
+            sit_down_button=self._scenario.standup.sit_down.trigger == "hands",
             response=self._names.index(self._scenario.response),
             responses=self._names,
         )

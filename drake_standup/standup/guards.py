@@ -113,14 +113,14 @@ class Measurements:
     # sensing.pull_cop_shift_m: how far the pull moves the centre of pressure under the
     # robot at its posture now (negative: back; 0: not measured). m.
     cop_shift_m: float = 0.0
-    # Someone asked for the stand-up (live mode's "Stand up" button): with
-    # trigger 'hands', as good as the pull.
-    stand_up: bool = False
+    # How often someone asked for the stand-up (live mode's "Stand up" button): with
+    # trigger 'hands', as good as the pull; after k sit-downs the (k+1)-th counts.
+    stand_up: float = 0.0
     # The seat pads' normal forces, buttocks, left and right thigh (phases.SEAT_PAD_ROWS;
     # NaN: not measured): what tells the sit-down its thighs and buttocks have touched. N.
     seat_fz_N: tuple[float, float, float] = (math.nan, math.nan, math.nan)
-    # Someone asked for the sit-down (live mode's "Sit down" button).
-    sit_down: bool = False
+    # How often someone asked for the sit-down (live mode's "Sit down" button).
+    sit_down: float = 0.0
     # How high the thigh pads' undersides are above the seat's top (kinematics: on the
     # iCub, the encoders and the base estimate; NaN: not known). m.
     thigh_gap_m: float = math.nan

@@ -16,9 +16,9 @@ from drake_standup.config.phases import (
     EVERY_PHASE,
     PHASES,
     PhaseTable,
-    resolve_descent,
     resolve_com_heights,
     resolve_com_x,
+    resolve_descent,
     resolve_postures,
 )
 from drake_standup.robot.limbs import joint_limits_rad

@@ -67,15 +67,24 @@ def next_memory(
 
 
 def returning(
-    memory: np.ndarray, nu: int, returns_to: int, share: float
+    memory: np.ndarray,
+    returns_to: int,
+    share: float,
+    trunk: np.ndarray,
+    trunk_leads_by: float = 1.0,
 ) -> tuple[np.ndarray, float]:
     """(the posture target, the base pitch target) share of the way from where the phase
-    began to those stand-up state returns_to began with."""
+    began to those stand-up state returns_to began with; the trunk (the joints where
+    trunk is True, and the pelvis' pitch) trunk_leads_by times as far along, up to all
+    the way."""
+    nu = len(trunk)
     pitches = 1 + nu * (1 + STAND_UP_STATES)
     q_from = memory[1 : 1 + nu]
     q_to = memory[1 + nu * returns_to : 1 + nu * (returns_to + 1)]
     pitch_from, pitch_to = memory[pitches + 1], memory[pitches + 1 + returns_to]
-    return q_from + share * (q_to - q_from), pitch_from + share * (pitch_to - pitch_from)
+    lead = min(1.0, share * trunk_leads_by)
+    shares = np.where(trunk, lead, share)
+    return q_from + shares * (q_to - q_from), pitch_from + lead * (pitch_to - pitch_from)
 
 
 def with_pitch(memory: np.ndarray, nu: int, pitch: float) -> np.ndarray:

@@ -77,9 +77,10 @@ def _maybe_sit_down(
     if mode.sit_downs >= sit.times or not calm or mode.guards.hands_held.on:
         return mode
     if sit.trigger == "time":
-        asked = standing >= sit.stand_s
+        asked = standing >= sit.stand_s if sit.at_s is None else m.t >= sit.at_s
     else:
-        asked = standing >= cfg.resume_after_s and (mode.guards.hands_lowered.on or m.sit_down)
+        button = m.sit_down > mode.sit_downs  # the k-th click asks for the k-th sit-down
+        asked = standing >= cfg.resume_after_s and (mode.guards.hands_lowered.on or button)
     return _enter_descent(mode, N_STATES + 1, m, table) if asked else mode
 
 
@@ -112,8 +113,8 @@ def _next_descent(
     )
     near = phase.exit.thighs_within_m
     done = _segment_done(mode, m.psi) or (near is not None and m.thigh_gap_m <= near)
-    if done and not landed and _untouched(mode, phase) and not mode.creeping:
-        return _creep(mode, m, phase)
+    if done and not landed and _untouched(mode, phase):
+        return _creep(mode, m, phase)  # again after each creep, until the touch
     if not (done and (landed or not phase.exit.unloaded)):
         return mode
     if mode.state == len(table.every()):
@@ -150,14 +151,17 @@ def _touches(
     mode: StandupMode, m: Measurements, cfg: StandupConfig, table: PhaseTable
 ) -> StandupMode:
     """The pad groups this phase lands that have touched the seat now: their landing
-    begins (their pads together carry more than sit_down.touch_force_N)."""
+    begins (their pads together carry more than sit_down.touch_force_N, or the thighs'
+    undersides are within sit_down.touch_gap_m of the seat's top: a landing the QP
+    lowers exactly onto the seat rests there with 2-6 N, measured)."""
     phase = table.phase(mode.state)
     land = list(mode.land_s)
     for k, pads in enumerate(SEAT_PADS):
         if pads not in phase.load or not math.isnan(land[k]):
             continue
         force = sum(f for f, name in zip(m.seat_fz_N, SEAT_LOADS, strict=True) if name == pads)
-        if force > cfg.sit_down.touch_force_N:
+        near = pads == "thighs" and m.thigh_gap_m <= cfg.sit_down.touch_gap_m
+        if force > cfg.sit_down.touch_force_N or near:
             land[k] = m.t
     if tuple(land) == mode.land_s:
         return mode

@@ -33,17 +33,16 @@ class StandupStateMachine(LeafSystem):
     Inputs: psi (1), com_W (3), heel_x_W (1), thigh_x_W (1; unconnected: never passed),
     thigh_z_W (1; unconnected: the thighs' height above the seat unknown),
     standing_pull_usage and braced_pull_usage (1 each; unconnected: 0, and never braced),
-    pull_cop_shift_m (1; unconnected: 0),
-    pad_forces_W (3 per pad, rows of the soles
-    given as sole_rows = (left, right)), hand_wrenches_W (12, payloads.HAND_WRENCHES), and
-    stand_up (1; > 0.5: go; unconnected: never) and sit_down (the same), which only the
-    live helper has, seat_pad_normal_forces_N (3; unconnected: the sit-down's pads never
-    touch).
-    Outputs: mode (abstract StandupMode), standup_state (1; 5-7: the sit-down), advances (1: the phase lets
-    psi advance), segment (payloads.SEGMENT), entry_times_s (4: the stand-up's states' last
-    entries, NaN for states not reached), held_back (4: [a backward pull holds it (1/0), the time it has waited so
-    far, s, a pull beyond the standing feet holds it (1/0), the part of that time it did,
-    s]).
+    pull_cop_shift_m (1; unconnected: 0), pad_forces_W (3 per pad, rows of the soles
+    given as sole_rows = (left, right)), hand_wrenches_W (12, payloads.HAND_WRENCHES),
+    stand_up and sit_down (1 each: how often the live page's buttons asked for them;
+    unconnected: never), which only the live helper has, and seat_pad_normal_forces_N (3;
+    unconnected: the sit-down's pads never touch).
+    Outputs: mode (abstract StandupMode), standup_state (1; 5-7: the sit-down), advances
+    (1: the phase lets psi advance), segment (payloads.SEGMENT), entry_times_s (4: the
+    stand-up's states' last entries, NaN for states not reached), held_back (4: [a
+    backward pull holds it (1/0), the time it has waited so far, s, a pull beyond the
+    standing feet holds it (1/0), the part of that time it did, s]).
     """
 
     def __init__(
@@ -122,8 +121,12 @@ class StandupStateMachine(LeafSystem):
             foot_fz_N=(float(pads[left, 2]), float(pads[right, 2])),
             hand_fx_N=(float(hands[0, 3]), float(hands[1, 3])),
             hand_fz_N=(float(hands[0, 5]), float(hands[1, 5])),
-            stand_up=self._stand_up.HasValue(context) and self._stand_up.Eval(context)[0] > 0.5,
-            sit_down=self._sit_down.HasValue(context) and self._sit_down.Eval(context)[0] > 0.5,
+            stand_up=float(self._stand_up.Eval(context)[0])
+            if self._stand_up.HasValue(context)
+            else 0.0,
+            sit_down=float(self._sit_down.Eval(context)[0])
+            if self._sit_down.HasValue(context)
+            else 0.0,
             thigh_gap_m=float(self._thigh_z.Eval(context)[0]) - self._seat_top_z
             if self._thigh_z.HasValue(context)
             else math.nan,

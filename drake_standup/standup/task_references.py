@@ -115,6 +115,8 @@ class PhaseReferences:
         self.q_target_min = q_min + margin
         self.q_target_max = q_max - margin
         arms = np.isin(joint_names, list(arm_joints))
+        # The trunk's joints (return_path.returning: a sit-down phase's trunk may lead).
+        self.trunk = np.array([name.startswith("torso_") for name in joint_names])
         self._by_state = {}
         for state, phase in enumerate(table.every(), start=1):
             target = joint_values(joint_names, phase.posture_rad, "posture_rad")
@@ -134,6 +136,7 @@ class PhaseReferences:
                     -braced_drop_m if braced and phase.lean else 0.0,
                     returns,
                     phase.stance_throughout,
+                    phase.trunk_leads_by,
                 )
 
     def __getitem__(self, key: int | tuple[int, bool]) -> StateReferences:
@@ -252,7 +255,13 @@ class TaskReferenceGenerator:
         )
         target, hold, pitch = state.posture_rad, state.posture_hold, state.base_pitch_rad
         if state.posture_returns_to:
-            target, pitch = returning(memory, nu, state.posture_returns_to, now.descent_progress)
+            target, pitch = returning(
+                memory,
+                state.posture_returns_to,
+                now.descent_progress,
+                self.phases.trunk,
+                state.trunk_leads_by,
+            )
             hold = np.zeros_like(state.posture_hold)
         memory = with_pitch(memory, nu, pitch)
         two_stages = self._config.posture_filter_stages == 2

@@ -209,7 +209,8 @@ def guard_holds(phase: Phase, mode: StandupMode, m: Measurements, cfg: StandupCo
     if dwell < min_time_s:
         return False
     pulled = g.hands_pulled.on or g.hands_held.on
-    if guard.asked and not (cfg.trigger == "time" or pulled or m.stand_up):
+    button = m.stand_up > mode.sit_downs  # the button's k-th click after k - 1 sit-downs
+    if guard.asked and not (cfg.trigger == "time" or pulled or button):
         return False
     if guard.segment_done and not (
         m.psi - mode.psi_entry >= mode.segment_psi or not any(mode.delta_m)

@@ -40,9 +40,9 @@ from drake_standup.control.controller import (
 from drake_standup.control.model import ControllerModel
 from drake_standup.ports.payloads import COM_REFERENCE, HAND_WRENCHES
 from drake_standup.standup.contact_schedule import ContactSchedule
-from drake_standup.standup.task_references import CarriedState, TaskReferenceGenerator, TickInputs
 from drake_standup.standup.return_path import memory_size
 from drake_standup.standup.sit_down import descent_progress
+from drake_standup.standup.task_references import CarriedState, TaskReferenceGenerator, TickInputs
 from drake_standup.standup.transitions import StandupMode
 
 _COMMANDED = DIAGNOSTICS["commanded_normal_force_N"]

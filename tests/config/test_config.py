@@ -225,6 +225,9 @@ def _full_scenario() -> Scenario:
             ("chair.cushion", {"modulus_Pa": 1e5}),
             ("initial.hips_behind_seat_edge_m", 0.16),
             ("initial.feet_ahead_of_seat_edge_m", 0.04),
+            ("standup.sit_down.trigger", "time"),
+            ("standup.sit_down.at_s", 9.0),
+            ("phases.lower.exit.thighs_within_m", 0.03),
         ],
     )
 
