@@ -168,7 +168,8 @@ class Phase:
     # carried before their release, over load_s (smoothstep). s.
     returns_to: str | None = None
     posture_as: str | None = None
-    # ... the trunk (the torso's joints and the pelvis' pitch) this many times as fast.
+    # ... the trunk (the torso's and the hips' pitch, the pelvis' pitch) this many times
+    # as fast (all the way once it is that far along).
     trunk_leads_by: float = 1.0
     # Its path done with a pad it lands not yet touching the seat, the reference creeps
     # this much lower (over load_s) until the touch; from the touch the reference's
@@ -275,7 +276,13 @@ class PhaseTable:
             com_kp_per_s2=[60.0, 40.0, 30.0],
             base_pitch_rad=0.3,
             seat_hold="hinged",
+            # Led by the legs' posture (the height row at stance_vertical_weight_scale),
+            # the trunk and the hips three times as far along: a person leans forward,
+            # then lowers. Led by the CoM, or with the trunk keeping pace, the knees bent
+            # first and the ankles hit their stops (-0.611 rad: 62-132 N on the soles).
             stance=True,
+            stance_throughout=True,
+            trunk_leads_by=3.0,
             when_hindered="stand",
         )
     )

@@ -74,8 +74,15 @@ def _one_sit_down(signals: dict, start: int, *, landing_window_s: float, settle_
     seat = thighs + forces.get("buttocks", np.zeros(len(t)))
     record: dict = {"start_s": float(t[start]), "seated_s": None, "sit_down_time_s": None}
     seated = _entries(state, SEATED, start)
+    back_up = _entries(state, STAND_UP_STATES, start)
+    if len(back_up) and (not len(seated) or back_up[0] < seated[0]):
+        # A pull against it stood the robot back up while it lowered: not a sit-down.
+        record["stood_back_up_s"] = float(t[back_up[0]])
+        seated = seated[:0]
     land = _entries(state, LAND, start)
-    descent = (np.arange(len(t)) >= start) & (state > STAND_UP_STATES)
+    idx = np.arange(len(t))
+    stop = seated[0] if len(seated) else (back_up[0] if len(back_up) else len(t))
+    descent = (idx >= start) & (idx < stop) & (state > STAND_UP_STATES)
     if descent.any():
         error = signals["com_W"][descent] - signals["com_reference_W"][descent]
         error = np.linalg.norm(error, axis=1)
@@ -87,13 +94,11 @@ def _one_sit_down(signals: dict, start: int, *, landing_window_s: float, settle_
     record["sit_down_time_s"] = float(t[i_seated] - t[start])
     again = _entries(state, 2, i_seated)
     stay_end = again[0] if len(again) else len(t)
-    stay = (np.arange(len(t)) < stay_end) & (t >= t[stay_end - 1] - settle_window_s)
-    stay &= np.arange(len(t)) >= i_seated
+    stay = (idx < stay_end) & (t >= t[stay_end - 1] - settle_window_s) & (idx >= i_seated)
     i_land = land[0] if len(land) else i_seated
-    window = (np.arange(len(t)) >= i_land) & (t <= t[i_seated] + landing_window_s)
-    window &= np.arange(len(t)) < stay_end
+    window = (idx >= i_land) & (t <= t[i_seated] + landing_window_s) & (idx < stay_end)
     settled_seat = float(seat[stay].mean())
-    own = (np.arange(len(t)) >= i_land) & (state == LAND)
+    own = (idx >= i_land) & (idx < i_seated) & (state == LAND)
     own_end = own & (t >= t[own].max() - 0.1) if own.any() else own
     landed = float(thighs[own_end].mean()) if own.any() else float("nan")
     record |= {
@@ -132,8 +137,9 @@ def _chatter(soles: np.ndarray | None, t: np.ndarray, start: int, window: np.nda
 def sit_down_metrics(
     signals: dict[str, np.ndarray], *, landing_window_s: float = 1.0, settle_window_s: float = 0.5
 ) -> dict:
-    """{} where the run never sat down; else sit_downs (one record a sit-down, as the
-    module docstring measures it) and the first's figures at the top level (keys)."""
+    """{} where the run never sat down; else sit_downs (one record a sit-down begun, as
+    the module docstring measures it; one a pull stood back up has stood_back_up_s and no
+    seated_s) and the first completed one's figures at the top level (keys)."""
     state = np.asarray(signals["state"])
     if len(state) < 2 or not np.any(state == LOWER):
         return {}
@@ -144,7 +150,8 @@ def sit_down_metrics(
         )
         for i in starts
     ]
-    first = records[0]
+    done = [r for r in records if r["seated_s"] is not None]
+    first = done[0] if done else records[-1]
     keys = (
         "sit_down_time_s",
         "landing_peak_N",

@@ -115,8 +115,11 @@ class PhaseReferences:
         self.q_target_min = q_min + margin
         self.q_target_max = q_max - margin
         arms = np.isin(joint_names, list(arm_joints))
-        # The trunk's joints (return_path.returning: a sit-down phase's trunk may lead).
-        self.trunk = np.array([name.startswith("torso_") for name in joint_names])
+        # The joints that lean the body forward (the torso, the hips: a sit-down phase's
+        # trunk may lead its return, return_path.returning).
+        self.trunk = np.array(
+            [name.startswith("torso_") or name.endswith("hip_pitch") for name in joint_names]
+        )
         self._by_state = {}
         for state, phase in enumerate(table.every(), start=1):
             target = joint_values(joint_names, phase.posture_rad, "posture_rad")

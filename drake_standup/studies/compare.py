@@ -190,15 +190,14 @@ def _by_helper(records: list[dict]) -> dict[str, dict[str, dict]]:
     return table
 
 
-def sooner_than_stiff(metrics: dict, stiff: dict | None) -> float | None:
-    """How much sooner than stiff the run stood up, a fraction of stiff's time (None
-    where either did not stand up)."""
+def sooner_than_stiff(
+    metrics: dict, stiff: dict | None, key: str = "standup_time_s"
+) -> float | None:
+    """How much sooner than stiff the run stood up (key: or sat down, sit_down_time_s),
+    a fraction of stiff's time (None where either did not succeed)."""
     if stiff is None or not (metrics.get("success") and stiff.get("success")):
         return None
-    mine, theirs = (
-        finite_number(metrics.get("standup_time_s")),
-        finite_number(stiff.get("standup_time_s")),
-    )
+    mine, theirs = finite_number(metrics.get(key)), finite_number(stiff.get(key))
     return None if mine is None or not theirs else 1.0 - mine / theirs
 
 
@@ -210,13 +209,20 @@ def markdown(records: list[dict]) -> str:
     head += " waited (s) | helper work (J) | positive work (J) | peak hand force (N) |"
     head += " impulse (N s) | path deviation (cm) | person's peak shoulder (N m) |"
     head += " person's peak lumbar (N m) | person's effort (N^2 m^2 s) |"
-    lines = [head, "|" + "---|" * 14]
+    # A cycle's sit-down (docs/sit_down.md), where a run sat down.
+    by_helper = _by_helper(records)
+    cycle = any(
+        m.get("sit_down_time_s") is not None for rs in by_helper.values() for m in rs.values()
+    )
+    if cycle:
+        head += " sit-down time (s) | sit-down sooner than stiff | landing peak / seated |"
+    lines = [head, "|" + "---|" * (17 if cycle else 14)]
 
     def cell(value, fmt: str, scale: float = 1.0) -> str:
         number = finite_number(value)
         return "" if number is None else format(scale * number, fmt)
 
-    for helper, responses in _by_helper(records).items():
+    for helper, responses in by_helper.items():
         for response, m in responses.items():
             sooner = sooner_than_stiff(m, responses.get("stiff")) if response != "stiff" else None
             stood = "yes" if m.get("success") else f"no: {m.get('failure_reason')}"
@@ -232,8 +238,19 @@ def markdown(records: list[dict]) -> str:
                 f"{cell(m.get('helper_peak_shoulder_torque_Nm'), '.1f')} | "
                 f"{cell(m.get('helper_peak_lumbar_torque_Nm'), '.0f')} | "
                 f"{cell(m.get('helper_effort_Nm2s'), '.0f')} |"
+                + (_cycle_cells(m, responses.get("stiff"), response, cell) if cycle else "")
             )
     return "\n".join(lines) + "\n"
+
+
+def _cycle_cells(m: dict, stiff: dict | None, response: str, cell) -> str:
+    """The sit-down's cells of a row (markdown)."""
+    sooner = None if response == "stiff" else sooner_than_stiff(m, stiff, "sit_down_time_s")
+    return (
+        f" {cell(m.get('sit_down_time_s'), '.2f')} | "
+        f"{'' if sooner is None else f'{round(100 * sooner):+d} %'} | "
+        f"{cell(m.get('landing_peak_ratio'), '.2f')} |"
+    )
 
 
 def draw(records: list[dict], path: Path) -> None:
