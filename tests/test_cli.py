@@ -150,10 +150,16 @@ def test_scenarios_lists_every_shipped_file(capsys):
     each with the first sentence of its leading comment."""
     code, stdout, _ = _cli(capsys, ["scenarios"])
     assert code == 0
+    # The two sections, each from its heading (a scenario and a sweep may share a name:
+    # scenarios/cycle.yaml and sweeps/cycle.yaml).
+    lines = stdout.splitlines()
+    at = [i for i, x in enumerate(lines) if x.startswith("sweeps (")]
+    assert len(at) == 1
+    sections = {"scenarios": lines[: at[0]], "sweeps": lines[at[0] :]}
     for folder in ("scenarios", "sweeps"):
         for path in sorted((REPO / folder).glob("*.yaml")):
             first = path.read_text().splitlines()[0].lstrip("# ")
-            (line,) = [x for x in stdout.splitlines() if x.split()[:1] == [path.stem]]
+            (line,) = [x for x in sections[folder] if x.split()[:1] == [path.stem]]
             assert first.split()[0] in line and len(line.split()) > 3
 
 

@@ -106,6 +106,4 @@ def test_a_cycles_stand_up_is_its_first_and_its_return_to_state_1_no_sit_back():
     signals = _signals()
     assert first_entry_times(signals["state"], signals["time_s"]) == (0.0, 3.0, 4.0, 5.0)
     assert sit_backs(signals["state"]) == 0
-    assert math.isclose(
-        sit_down_metrics(signals)["sit_downs"][0]["seated_s"], 12.0, abs_tol=1e-9
-    )
+    assert math.isclose(sit_down_metrics(signals)["sit_downs"][0]["seated_s"], 12.0, abs_tol=1e-9)

@@ -49,7 +49,7 @@ def test_no_truth_reaches_the_controller_under_icub(built):
     brain = systems["standup_controller"]
     for i in range(brain.num_input_ports()):
         port = brain.get_input_port(i)
-        if port.get_name() == "stand_up":
+        if port.get_name() in ("stand_up", "sit_down"):  # the live page's buttons
             continue
         source, _ = _leaf_source(root, brain, port.get_index())
         assert source.get_name() in SENSES, (port.get_name(), source.get_name())
