@@ -39,6 +39,7 @@ from drake_standup.standup.transitions import (
     N_STATES,
     SEAT_LOADS,
     StandupMode,
+    _sit_back,
     next_mode,
 )
 
@@ -279,26 +280,13 @@ def _stand_again(mode: StandupMode, m: Measurements, table: PhaseTable) -> Stand
 
 def _seated(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMode:
     """State 1 again, every pad seated (no release, no landing), the seat's hold as after
-    a sit-back: the reference returns from where it is to where the CoM sat at the start
-    over phases.seated.segment_psi, as after a sit-back; the stand-up may be asked again
+    a sit-back (transitions._sit_back: the reference returns from where it is to where the
+    CoM sat at the start over phases.seated.segment_psi); the stand-up may be asked again
     after sit_down.seated_s."""
-    x_now = mode.reference(m.psi, m.com_W)
-    entry = [m.t] + [math.nan] * (len(mode.entry_times_s) - 1)
     return dataclasses.replace(
-        mode,
-        state=1,
-        entry_times_s=tuple(entry),
-        psi_entry=m.psi,
-        segment_psi=table.seated.segment_psi,
-        x_start_m=tuple(float(v) for v in x_now),
-        delta_m=tuple(float(a - b) for a, b in zip(mode.x_seated_m, x_now, strict=True)),
-        height_follows=False,
-        resume_end_m=_NAN3,
-        sat_back=True,
-        release_s=(math.nan,) * len(SEAT_PADS),
+        _sit_back(mode, m, table),
         land_s=(math.nan,) * len(SEAT_PADS),
         creeping=False,
         sit_downs=mode.sit_downs + 1,
         standing_since_s=math.nan,
-        held_back_s=mode.held_back_s,
     )

@@ -327,27 +327,27 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
 SEAT_LOADS = tuple(group for _, group in SEAT_PAD_ROWS)
 
 
+def _seat_ramps(table: PhaseTable, phase_of, duration: str) -> list[tuple]:
+    """(state, the phase's duration attribute, s, the entries of SEAT_LOADS, its index in
+    SEAT_PADS) of each pad group phase_of(pads) names a state for."""
+    ramps = []
+    for k, pads in enumerate(SEAT_PADS):
+        state = phase_of(pads)
+        if state is not None:
+            rows = [i for i, name in enumerate(SEAT_LOADS) if name == pads]
+            ramps.append((state, getattr(table.phase(state), duration), rows, k))
+    return ramps
+
+
 def seat_releases(table: PhaseTable) -> list[tuple[int, float, list[int], int]]:
     """(the state that releases it, over how long, s, the entries of SEAT_LOADS, its index
     in SEAT_PADS) of each pad group the table releases."""
-    releases = []
-    for k, pads in enumerate(SEAT_PADS):
-        state = table.unloading_phase(pads)
-        if state is not None:
-            rows = [i for i, name in enumerate(SEAT_LOADS) if name == pads]
-            releases.append((state, table.phase(state).unload_s, rows, k))
-    return releases
+    return _seat_ramps(table, table.unloading_phase, "unload_s")
 
 
 def seat_landings(table: PhaseTable) -> list[tuple[int, float, list[int], int]]:
     """seat_releases' entries for the pad groups a sit-down phase lands (phase.load)."""
-    landings = []
-    for k, pads in enumerate(SEAT_PADS):
-        state = table.landing_phase(pads)
-        if state is not None:
-            rows = [i for i, name in enumerate(SEAT_LOADS) if name == pads]
-            landings.append((state, table.phase(state).load_s, rows, k))
-    return landings
+    return _seat_ramps(table, table.landing_phase, "load_s")
 
 
 def seat_loads(

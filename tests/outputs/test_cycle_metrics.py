@@ -7,17 +7,11 @@ import math
 
 import numpy as np
 import pytest
+from synthetic_pads import PADS
 
 from drake_standup.outputs.cycle import first_entry_times, sit_down_metrics
 from drake_standup.outputs.metrics import sit_backs
 
-PADS = {
-    "l_sole_pad": "soles",
-    "r_sole_pad": "soles",
-    "l_thigh_pad": "thighs",
-    "r_thigh_pad": "thighs",
-    "buttocks_pad": "buttocks",
-}
 DT = 0.01
 # Stand-up 2 at 3 s, 3 at 4 s, 4 at 5 s; lower at 9, land at 10, settle at 11, seated at
 # 12; the next stand-up's state 2 at 15 s, 3 at 16, 4 at 17.

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from synthetic_pads import PADS
 
 from drake_standup.outputs.metrics import (
     helper_metrics,
@@ -15,13 +16,6 @@ from drake_standup.outputs.metrics import (
     torso_twist,
 )
 
-PADS = {
-    "l_sole_pad": "soles",
-    "r_sole_pad": "soles",
-    "l_thigh_pad": "thighs",
-    "r_thigh_pad": "thighs",
-    "buttocks_pad": "buttocks",
-}
 DT = 0.004
 
 
