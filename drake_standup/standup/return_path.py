@@ -4,9 +4,9 @@ path. The task references keep the memory in their posture state (task_reference
 these are its pure functions.
 
     memory = [the last tick's state, q_ref when the state began (nu), the measured joint
-              positions when each stand-up state 1-4 began (4 nu), the base pitch target
-              of the last tick, the one when the state began, the measured base pitch
-              when each stand-up state began (4)]
+              positions when each stand-up state 1-4 began from the one before it (4 nu),
+              the base pitch target of the last tick, the one when the state began, the
+              measured base pitch when each stand-up state began so (4)]
 
 A sit-down phase returning to stand-up state k aims its posture at q_from + s (q_k -
 q_from) and its pelvis' pitch likewise, s the share of its path the CoM reference has
@@ -57,10 +57,12 @@ def next_memory(
     if memory[0] == state:
         return memory
     memory = memory.copy()  # the caller's is the system's state
+    on_the_way_up = memory[0] == state - 1
     memory[0] = state
     memory[1 : 1 + nu] = q_reference
     memory[pitches + 1] = memory[pitches]  # the pitch aimed at when the state began
-    if state <= STAND_UP_STATES:
+    # Only on the way up: standing again from a lowering, state 4 began half-way down.
+    if state <= STAND_UP_STATES and on_the_way_up:
         memory[1 + nu * state : 1 + nu * (state + 1)] = q_now
         memory[pitches + 1 + state] = pitch_now
     return memory

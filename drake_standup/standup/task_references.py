@@ -43,6 +43,7 @@ from drake_standup.config.responses import SHIPPED, Response
 from drake_standup.control.smooth import psi_clock_blend, smoothstep
 from drake_standup.control.targets import StateReferences, TaskReferences, joint_values
 from drake_standup.control.tasks import BaseTarget, MomentumLaw, next_posture_reference
+from drake_standup.control.tasks.base import base_orientation_reference
 from drake_standup.control.tasks.posture import posture_acceleration_reference
 from drake_standup.control.terms import RobotTerms
 from drake_standup.robot.spatial import skew
@@ -191,6 +192,12 @@ class TaskReferenceGenerator:
         self._trunk = None
         if config.standing_trunk_attitude and trunk is not None and len(trunk):
             self._trunk = (np.asarray(trunk), np.asarray(v_joints)[np.asarray(trunk)])
+        self._leaning = None
+        if config.lowering_attitude and v_joints is not None:
+            places = np.flatnonzero(phases.trunk)
+            self._leaning = (places, np.asarray(v_joints)[places])
+        zeta, kp = config.base_orientation_damping_ratio, config.base_orientation_kp_per_s2
+        self._base_kd = 2.0 * zeta * math.sqrt(kp)
         self._posture_kd = 2.0 * config.posture_damping_ratio * math.sqrt(config.posture_kp_per_s2)
 
     def _trunk_Ldot(
@@ -208,6 +215,24 @@ class TaskReferenceGenerator:
         )
         A_ang = terms.M[:3, v] - skew(terms.p_BoCom) @ terms.M[3:6, v]
         return stance * (A_ang @ qddot)
+
+    def _leaning_Ldot(
+        self, terms: RobotTerms, q_reference: np.ndarray, R_WB_target: np.ndarray
+    ) -> np.ndarray:
+        """A_G,ang [wdot*_WB; qddot*_trunk]: the angular momentum rate that the pelvis'
+        pitch and the trunk's pitch joints, accelerating toward their targets, make."""
+        places, v = self._leaning
+        config = self._config
+        q = terms.q[self._q_joints][places]
+        qddot = posture_acceleration_reference(
+            q, terms.v[v], q_reference[places], config.posture_kp_per_s2, self._posture_kd
+        )
+        wdot = base_orientation_reference(
+            terms.R_WB, terms.v[:3], R_WB_target, config.base_orientation_kp_per_s2, self._base_kd
+        )
+        M = terms.M
+        A_ang = M[:3, :] - skew(terms.p_BoCom) @ M[3:6, :]
+        return A_ang[:, :3] @ wdot + A_ang[:, v] @ qddot
 
     def _stance(self, state: StateReferences, path_progress: float) -> tuple[float, float]:
         """(how far the legs have taken over the end of the rise, 0-1; the momentum
@@ -307,6 +332,12 @@ class TaskReferenceGenerator:
         q_reference, next_posture, base_yaw, pitch = self._posture(
             terms, state, carried.posture, psi_dot, now
         )
+        trunk_Ldot = self._trunk_Ldot(terms, q_reference, stance)
+        R_WB_target = self.base_target(base_yaw, pitch)
+        # On the feet (the lowering, the landing) the contacts lean the body; seated, the seat.
+        if self._leaning is not None and state.posture_returns_to and state.stance_throughout:
+            leaning = self._leaning_Ldot(terms, q_reference, R_WB_target)
+            trunk_Ldot = leaning if trunk_Ldot is None else trunk_Ldot + leaning
         momentum = self.momentum.target(
             terms,
             com_target,
@@ -317,7 +348,7 @@ class TaskReferenceGenerator:
             height_integral=carried.height_integral,
             pull_W=F_hand_W[3:6] + F_hand_W[9:12] if helped else None,
             heading_rad=base_yaw,
-            trunk_Ldot=self._trunk_Ldot(terms, q_reference, stance),
+            trunk_Ldot=trunk_Ldot,
         )
         return TaskReferences(
             standup_state=standup_state,
@@ -325,7 +356,7 @@ class TaskReferenceGenerator:
             Ldot_star=momentum.Ldot_star,
             tau_hand=tau_hand,
             q_reference=q_reference,
-            R_WB_target=self.base_target(base_yaw, pitch),
+            R_WB_target=R_WB_target,
             helpful_force_W=momentum.helpful_force_W,
             lean_W=lean,
             vertical_weight_scale=vertical_weight_scale,

@@ -11,6 +11,7 @@ from functools import partial
 
 import numpy as np
 import pytest
+from pydrake.math import RotationMatrix
 
 from drake_standup.config import ControllerConfig, Scenario
 from drake_standup.config.inputs import TASK_FRAMES
@@ -503,3 +504,67 @@ def test_standing_the_contacts_are_asked_the_trunks_posture_moment(rig):
         standing.Ldot_star[:3] - alone_standing.Ldot_star[:3], expected, rtol=1e-9, atol=1e-12
     )
     np.testing.assert_array_equal(standing.Ldot_star[3:], alone_standing.Ldot_star[3:])
+
+
+def test_lowering_the_contacts_are_asked_the_pelvis_and_trunk_pitch_moment(rig):
+    """In a sit-down's lowering and landing (the phases led by the legs' posture) Ldot_ang*
+    gains A_G,ang [wdot*_WB; qddot*_trunk]: the pelvis toward its pitch target (wdot* =
+    -K_P theta k - K_D w, with Drake's pelvis pose) and the torso's and hips' pitch joints
+    toward the posture reference; each column of A_G,ang is Drake's angular momentum about
+    the CoM with a unit rate of that velocity alone. In the settle (seated), standing and
+    with lowering_attitude off it adds nothing."""
+    plant, context, instance, joints = rig["plant"], rig["context"], rig["instance"], rig["joints"]
+    names = list(joints.names)
+    v_joints = np.asarray(joints.v_indices)
+    pitch_joints = [k for k, n in enumerate(names) if n.startswith("torso_") or "hip_pitch" in n]
+
+    def generator(config):
+        return TaskReferenceGenerator(
+            config, rig["phases"], as_slice(joints.q_indices), T, rig["g"], v_joints=v_joints
+        )
+
+    plain = rig["generator"]
+    results = {}
+    try:
+        for on in (True, False):
+            rig["generator"] = generator(dataclasses.replace(CONFIG, lowering_attitude=on))
+            for state in (4, 5, 6, 7):
+                results[on, state] = _calc(rig, state, progress=0.5)[0]
+    finally:
+        rig["generator"] = plain
+    for state in (4, 7):
+        np.testing.assert_array_equal(
+            results[True, state].Ldot_star, results[False, state].Ldot_star
+        )
+    p, _, _, _ = _drake_com(rig)
+    v = rig["x"][plant.num_positions(instance) :]
+    q = plant.GetPositions(context, instance)
+    scratch = plant.CreateDefaultContext()
+    plant.SetPositions(scratch, instance, q)
+    R_WB = plant.EvalBodyPoseInWorld(scratch, plant.GetBodyByName("root_link", instance))
+    R_WB = R_WB.rotation().matrix()
+
+    def column(j):
+        unit = np.zeros(plant.num_velocities(instance))
+        unit[j] = 1.0
+        plant.SetVelocities(scratch, instance, unit)
+        return plant.CalcSpatialMomentumInWorldAboutPoint(scratch, [instance], p).rotational()
+
+    base = np.array([column(j) for j in range(3)]).T
+    trunk = np.array([column(v_joints[k]) for k in pitch_joints]).T
+    kp, zeta = CONFIG.posture_kp_per_s2, CONFIG.posture_damping_ratio
+    kp_b, zeta_b = CONFIG.base_orientation_kp_per_s2, CONFIG.base_orientation_damping_ratio
+    for state in (5, 6):
+        on = results[True, state]
+        q_ref = on.q_reference[pitch_joints]
+        q_now = q[joints.q_indices][pitch_joints]
+        qddot = -kp * (q_now - q_ref) - 2.0 * zeta * math.sqrt(kp) * v[v_joints[pitch_joints]]
+        # theta k: the rotation vector of R_WB R_target^T, from its angle-axis.
+        error = RotationMatrix(R_WB @ on.R_WB_target.T).ToAngleAxis()
+        wdot = -kp_b * error.angle() * error.axis() - 2.0 * zeta_b * math.sqrt(kp_b) * v[:3]
+        expected = base @ wdot + trunk @ qddot
+        assert np.abs(expected).max() > 1e-2  # the rig's pelvis and trunk move
+        np.testing.assert_allclose(
+            on.Ldot_star[:3] - results[False, state].Ldot_star[:3], expected, rtol=1e-9, atol=1e-9
+        )
+        np.testing.assert_array_equal(on.Ldot_star[3:], results[False, state].Ldot_star[3:])
