@@ -73,3 +73,7 @@ def test_a_pull_against_the_lowering_stands_the_robot_back_up(tmp_path):
     waiting = (t > first["stood_back_up_s"]) & (t < second["start_s"])
     assert seat[waiting].max() < 1.0
     assert second["start_s"] > 11.8 and second["seated_s"] is not None
+    # The second sit-down returns along the way up, not to where the first one turned
+    # back (that half-lowered pose landed the thighs at 3 times their load).
+    assert second["landing_peak_ratio"] <= 1.3
+    assert second["thighs_landing_peak_ratio"] <= 1.3
