@@ -40,10 +40,10 @@ from drake_standup.standup.transitions import (
     SEAT_LOADS,
     StandupMode,
     _sit_back,
+    held_here,
     next_mode,
+    phase_segment,
 )
-
-_NAN3 = (math.nan, math.nan, math.nan)
 
 
 def next_cycle_mode(
@@ -224,35 +224,24 @@ def _enter_descent(
     if not resuming:
         entry[state - 1] = m.t
         start, to = tuple(float(v) for v in x_start), tuple(float(v) for v in end)
-    return dataclasses.replace(
+    return phase_segment(
         mode,
-        state=state,
-        entry_times_s=tuple(entry),
+        state,
+        phase,
+        m,
+        x_start,
+        delta,
+        entry=entry,
         phase_from_m=start,
         phase_to_m=to,
         creeping=False,
-        psi_entry=m.psi,
-        segment_psi=phase.segment_psi,
-        x_start_m=tuple(float(v) for v in x_start),
-        delta_m=tuple(float(v) for v in delta),
-        height_follows=phase.com_height_follows,
-        resume_end_m=_NAN3,
     )
 
 
 def _hold(mode: StandupMode, m: Measurements) -> StandupMode:
     """The reference held where it is (psi = t, nothing advances) until the pull against
     the sit-down eases; the phase then goes on to where its segment was to end."""
-    x_now = mode.reference(m.psi, m.com_W)
-    return dataclasses.replace(
-        mode,
-        psi_entry=m.psi,
-        segment_psi=1.0,
-        x_start_m=tuple(float(v) for v in x_now),
-        delta_m=(0.0, 0.0, 0.0),
-        height_follows=False,
-        resume_end_m=tuple(float(v) for v in mode.segment_end()),
-    )
+    return held_here(mode, m)
 
 
 def _stand_again(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMode:
@@ -262,20 +251,7 @@ def _stand_again(mode: StandupMode, m: Measurements, table: PhaseTable) -> Stand
     rise = table.rise
     end = np.array(mode.starts_m[N_STATES - 1], dtype=float)
     end[2] = rise.com_height_m if rise.com_height_m is not None else x_now[2]
-    entry = list(mode.entry_times_s)
-    entry[N_STATES - 1] = m.t
-    return dataclasses.replace(
-        mode,
-        state=N_STATES,
-        entry_times_s=tuple(entry),
-        psi_entry=m.psi,
-        segment_psi=rise.segment_psi,
-        x_start_m=tuple(float(v) for v in x_now),
-        delta_m=tuple(float(v) for v in end - x_now),
-        height_follows=False,
-        resume_end_m=_NAN3,
-        standing_since_s=math.nan,
-    )
+    return phase_segment(mode, N_STATES, rise, m, x_now, end - x_now, standing_since_s=math.nan)
 
 
 def _seated(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMode:

@@ -264,16 +264,22 @@ def _step_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> Standup
     them) enters this phase again, whose segment then ends where the interrupted one
     would have (docs/design.md, "Hindering pulls"). The hold keeps the height
     of the reference used when it began (height_follows off)."""
-    x_now = mode.reference(m.psi, m.com_W)
     entry = list(mode.entry_times_s)
     entry[mode.state - 1] = math.nan
     left = table.phase(mode.state).unload
     release = [math.nan if pads in left else s for pads, s in zip(SEAT_PADS, mode.release_s)]
+    held = held_here(mode, m)
+    return dataclasses.replace(
+        held, release_s=tuple(release), state=mode.state - 1, entry_times_s=tuple(entry)
+    )
+
+
+def held_here(mode: StandupMode, m: Measurements) -> StandupMode:
+    """The reference held where it is (psi = t, nothing advances, at the height it has),
+    remembering where its segment was to end (resume_end_m)."""
+    x_now = mode.reference(m.psi, m.com_W)
     return dataclasses.replace(
         mode,
-        release_s=tuple(release),
-        state=mode.state - 1,
-        entry_times_s=tuple(entry),
         psi_entry=m.psi,
         segment_psi=1.0,
         x_start_m=tuple(float(v) for v in x_now),
@@ -304,23 +310,41 @@ def _enter(mode: StandupMode, state: int, m: Measurements, table: PhaseTable) ->
         delta[2] = phase.com_height_m - x_start[2]
     if mode.stepped_back():
         delta[:2] = np.array(mode.resume_end_m[:2]) - x_start[:2]
-    entry = list(mode.entry_times_s)
-    entry[state - 1] = m.t
     starts = list(mode.starts_m)
     starts[state - 1] = tuple(float(v) for v in x_start)
-    entered = dataclasses.replace(
+    entered = phase_segment(mode, state, phase, m, x_start, delta, starts_m=tuple(starts))
+    return _begin_releases(entered, phase, m)
+
+
+def phase_segment(
+    mode: StandupMode,
+    state: int,
+    phase: Phase,
+    m: Measurements,
+    x_start: np.ndarray,
+    delta: np.ndarray,
+    *,
+    entry: list[float] | None = None,
+    **more,
+) -> StandupMode:
+    """mode in state with the phase's segment from x_start by delta, from now (psi) over
+    phase.segment_psi, its height following the CoM where the phase says so; entry: the
+    states' entry times (None: mode's, state's entered now); more: other fields to set."""
+    if entry is None:
+        entry = list(mode.entry_times_s)
+        entry[state - 1] = m.t
+    return dataclasses.replace(
         mode,
         state=state,
         entry_times_s=tuple(entry),
-        starts_m=tuple(starts),
         psi_entry=m.psi,
         segment_psi=phase.segment_psi,
         x_start_m=tuple(float(v) for v in x_start),
         delta_m=tuple(float(v) for v in delta),
         height_follows=phase.com_height_follows,
         resume_end_m=_NAN3,
+        **more,
     )
-    return _begin_releases(entered, phase, m)
 
 
 # The seat pads, as seat_loads orders them, and their pad group (phases.SEAT_PADS).
