@@ -25,7 +25,6 @@ filter, lean and admittance, the torques, the soles' planned wrenches and the di
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -44,7 +43,7 @@ from drake_standup.standup.contact_schedule import ContactSchedule
 from drake_standup.standup.return_path import memory_size
 from drake_standup.standup.sit_down import descent_progress
 from drake_standup.standup.task_references import CarriedState, TaskReferenceGenerator, TickInputs
-from drake_standup.standup.transitions import N_STATES, StandupMode
+from drake_standup.standup.transitions import StandupMode
 
 _COMMANDED = DIAGNOSTICS["commanded_normal_force_N"]
 
@@ -114,13 +113,6 @@ class StandupWholeBodyController(LeafSystem):
         port = self._inputs["psi_dot"]
         return float(port.Eval(context)[0]) if port.HasValue(context) else 1.0
 
-    def _descent_progress(self, mode: StandupMode, context: Context) -> float:
-        """sit_down.descent_progress in a sit-down's state (NaN in the stand-up's)."""
-        if mode.state <= N_STATES:
-            return math.nan
-        com_reference = self._input("com_reference", context)[:3]
-        return descent_progress(mode, com_reference, self._schedule.table)
-
     def _CalcEstimate(self, context: Context, output: BasicVector) -> None:
         output.SetAtIndex(0, context.get_discrete_state(self._weighing).GetAtIndex(0))
 
@@ -163,7 +155,9 @@ class StandupWholeBodyController(LeafSystem):
                 response=int(round(self._input("response", context)[0])),
                 psi_dot=self._psi_dot(context),
                 braced=mode.guards.brace.on,
-                descent_progress=self._descent_progress(mode, context),
+                descent_progress=descent_progress(
+                    mode, self._input("com_reference", context)[:3], self._schedule.table
+                ),
             ),
             CarriedState(
                 momentum_integral=state.get_value(self._integral),

@@ -64,10 +64,12 @@ NO_PULL = np.zeros(12)
 
 
 class _FixedSchedule:
-    """A contact schedule that answers every tick with the commands the rig fixed."""
+    """A contact schedule that answers every tick with the commands the rig fixed (its
+    phase table, as ContactSchedule's, the one the controller reads the sit-down's from)."""
 
-    def __init__(self):
+    def __init__(self, table: PhaseTable):
         self.commands = None
+        self.table = table
 
     def tick(self, mode, t, memory, commanded_N, measured_N):
         return self.commands, memory.copy()
@@ -90,7 +92,7 @@ class _Rig:
         schedule = PhaseReferences(
             self.table, self.config, joints.names, joints.q_min, joints.q_max
         )
-        self.schedule = _FixedSchedule()
+        self.schedule = _FixedSchedule(self.table)
         self.controller = WholeBodyController(
             plant,
             self.specs,
