@@ -169,9 +169,9 @@ class ControllerConfig:
     # stops after a strong pull. Through the rise the trunk stays free: held throughout,
     # iCubDarmstadt01's thighs slapped at their release (docs/decisions/022-standing-trunk.md).
     standing_trunk_attitude: bool = True
-    # In a sit-down's lowering the angular momentum's target asks the contacts for the
-    # moment the pelvis' pitch and the trunk's pitch joints need to lean forward
-    # (their accelerations through the centroidal momentum matrix), as the standing trunk's.
+    # In a sit-down's lowering and landing the angular momentum's target asks the contacts
+    # for the moment the pelvis' pitch and the trunk's joints (the torso's, the hips' pitch)
+    # need to lean forward (their accelerations through the centroidal momentum matrix).
     lowering_attitude: bool = True
     # Integral gain on the CoM height error in the stance (standup/task_references.py). 1/s^3.
     stance_height_ki_per_s3: float = 100.0

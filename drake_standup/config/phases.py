@@ -168,7 +168,7 @@ class Phase:
     # carried before their release, over load_s (smoothstep). s.
     returns_to: str | None = None
     posture_as: str | None = None
-    # ... the trunk (the torso's and the hips' pitch, the pelvis' pitch) this many times
+    # ... the trunk (the torso's joints, the hips' pitch, the pelvis' pitch) this many times
     # as fast (all the way once it is that far along).
     trunk_leads_by: float = 1.0
     # Its path done with a pad it lands not yet touching the seat, the reference creeps

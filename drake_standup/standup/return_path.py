@@ -77,7 +77,7 @@ def returning(
 ) -> tuple[np.ndarray, float]:
     """(the posture target, the base pitch target) share of the way from where the phase
     began to those stand-up state returns_to began with; the trunk (the joints where
-    trunk is True: the torso's and the hips' pitch, and the pelvis' pitch) trunk_leads_by
+    trunk is True: the torso's joints and the hips' pitch, and the pelvis' pitch) trunk_leads_by
     times as far along, up to all the way: the body leans forward before it lowers."""
     nu = len(trunk)
     pitches = 1 + nu * (1 + STAND_UP_STATES)

@@ -148,6 +148,11 @@ class PhaseReferences:
         return self._by_state[key if isinstance(key, tuple) else (key, False)]
 
 
+def _angular_rows(terms: RobotTerms, columns) -> np.ndarray:
+    """A_G,ang's columns: the angular momentum about the CoM per unit of those velocities."""
+    return terms.M[:3, columns] - skew(terms.p_BoCom) @ terms.M[3:6, columns]
+
+
 class TaskReferenceGenerator:
     """The module docstring's references for each tick: the CoM target chain, then each
     task's law, from the phase's references and the state the tick keeps (momentum and
@@ -200,39 +205,41 @@ class TaskReferenceGenerator:
         self._base_kd = 2.0 * zeta * math.sqrt(kp)
         self._posture_kd = 2.0 * config.posture_damping_ratio * math.sqrt(config.posture_kp_per_s2)
 
-    def _trunk_Ldot(
-        self, terms: RobotTerms, q_reference: np.ndarray, stance: float
-    ) -> np.ndarray | None:
-        """stance A_G,ang[trunk] qddot*_trunk: the angular momentum rate that the trunk's
-        posture acceleration (posture_acceleration_reference toward q_reference) makes,
-        asked of the contacts in the stance (None: not in the stance, or no trunk)."""
-        if self._trunk is None or stance <= 0.0:
-            return None
-        places, v = self._trunk
+    def _posture_Ldot(
+        self, terms: RobotTerms, joints: tuple[np.ndarray, np.ndarray], q_reference: np.ndarray
+    ) -> np.ndarray:
+        """A_G,ang[joints] qddot*: the angular momentum rate that the joints' posture
+        accelerations (posture_acceleration_reference toward q_reference) make; joints:
+        (their places among the actuated joints, their entries of v)."""
+        places, v = joints
         q = terms.q[self._q_joints][places]
         qddot = posture_acceleration_reference(
             q, terms.v[v], q_reference[places], self._config.posture_kp_per_s2, self._posture_kd
         )
-        A_ang = terms.M[:3, v] - skew(terms.p_BoCom) @ terms.M[3:6, v]
-        return stance * (A_ang @ qddot)
+        return _angular_rows(terms, v) @ qddot
+
+    def _trunk_Ldot(
+        self, terms: RobotTerms, q_reference: np.ndarray, stance: float
+    ) -> np.ndarray | None:
+        """stance A_G,ang[trunk] qddot*_trunk: the angular momentum rate that the trunk's
+        posture acceleration makes, asked of the contacts in the stance (None: not in the
+        stance, or no trunk)."""
+        if self._trunk is None or stance <= 0.0:
+            return None
+        return stance * self._posture_Ldot(terms, self._trunk, q_reference)
 
     def _leaning_Ldot(
         self, terms: RobotTerms, q_reference: np.ndarray, R_WB_target: np.ndarray
     ) -> np.ndarray:
-        """A_G,ang [wdot*_WB; qddot*_trunk]: the angular momentum rate that the pelvis'
-        pitch and the trunk's pitch joints, accelerating toward their targets, make."""
-        places, v = self._leaning
+        """A_G,ang [wdot*_WB; qddot*]: the angular momentum rate that the pelvis, toward its
+        target, and the joints that lean the body (phases.trunk: the torso's, the hips'
+        pitch), toward their posture references, make."""
         config = self._config
-        q = terms.q[self._q_joints][places]
-        qddot = posture_acceleration_reference(
-            q, terms.v[v], q_reference[places], config.posture_kp_per_s2, self._posture_kd
-        )
         wdot = base_orientation_reference(
             terms.R_WB, terms.v[:3], R_WB_target, config.base_orientation_kp_per_s2, self._base_kd
         )
-        M = terms.M
-        A_ang = M[:3, :] - skew(terms.p_BoCom) @ M[3:6, :]
-        return A_ang[:, :3] @ wdot + A_ang[:, v] @ qddot
+        base = _angular_rows(terms, slice(0, 3)) @ wdot
+        return base + self._posture_Ldot(terms, self._leaning, q_reference)
 
     def _stance(self, state: StateReferences, path_progress: float) -> tuple[float, float]:
         """(how far the legs have taken over the end of the rise, 0-1; the momentum
