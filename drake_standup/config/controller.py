@@ -173,6 +173,14 @@ class ControllerConfig:
     # for the moment the pelvis' pitch and the trunk's joints (the torso's, the hips' pitch)
     # need to lean forward (their accelerations through the centroidal momentum matrix).
     lowering_attitude: bool = True
+    # In a phase whose posture leads (phases.settle), the momentum task's CoM rows weigh
+    # this fraction of the task's weight: at 0.1 the CoM path still won and the torso
+    # folded onto its stop; at 1e-4 the pitch the contacts were asked for was met to
+    # 0.01 N m (docs/results.md, "Why the settle rocks").
+    posture_led_com_weight_scale: float = 1.0e-4
+    # ... reached over this share of the phase's path (the scale's exponent a smoothstep
+    # of it): released at once, the plan stepped (21 N on the soles on a 0.25 m seat).
+    posture_led_fade_progress: float = 0.3
     # Integral gain on the CoM height error in the stance (standup/task_references.py). 1/s^3.
     stance_height_ki_per_s3: float = 100.0
     # The lean's first-order lag: the pull's moment, not its jitter, and about the CoM

@@ -171,6 +171,13 @@ class Phase:
     # ... the trunk (the torso's joints, the hips' pitch, the pelvis' pitch) this many times
     # as fast (all the way once it is that far along).
     trunk_leads_by: float = 1.0
+    # The posture leads and the CoM goes where it puts it: the momentum task's CoM rows
+    # at controller.posture_led_com_weight_scale of their weight, and the contacts asked
+    # for the moment the pelvis and trunk need (controller.lowering_attitude). For a
+    # seated return: its CoM path (to the seat's support line) and its posture (to the
+    # seated pose) end 3.6 cm apart, and, the CoM held to its path, the torso folded
+    # onto its stop as the pelvis turned upright (docs/results.md, "Why the settle rocks").
+    posture_leads: bool = False
     # Its path done with a pad it lands not yet touching the seat, the reference creeps
     # this much lower (over load_s) until the touch; from the touch the reference's
     # height follows the CoM (the seat takes it). m.
@@ -316,6 +323,7 @@ class PhaseTable:
             returns_to="seated",
             com_height_follows=True,
             seat_hold="hinged",
+            posture_leads=True,
             load=["buttocks"],
             load_s=0.5,
             when_hindered="hold",

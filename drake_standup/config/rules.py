@@ -172,7 +172,8 @@ RULES: list[tuple[Range | int | str | tuple[str, ...], str]] = [
     (
         FRACTION,
         "standup.guard_off_ratio standup.reseat_above_thigh_load "
-        "controller.stance_vertical_weight_scale",
+        "controller.stance_vertical_weight_scale controller.posture_led_com_weight_scale "
+        "controller.posture_led_fade_progress",
     ),
     (2, "human.reactive.path_xz_m[*]"),
     (

@@ -41,6 +41,8 @@ class StateReferences:
     stance_throughout: bool = False
     # A sit-down phase's trunk returns this many times as fast along the path.
     trunk_leads_by: float = 1.0
+    # The posture leads, the CoM follows it (Phase.posture_leads).
+    posture_leads: bool = False
 
 
 @dataclass(slots=True)
@@ -67,3 +69,5 @@ class TaskReferences:
     next_posture: np.ndarray
     # The admittance's [offset (3), rate (3)] after this tick (response compliant), m, m/s.
     next_compliance: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    # The momentum task's CoM rows' weight, a fraction of it (Phase.posture_leads).
+    com_weight_scale: float = 1.0

@@ -27,7 +27,7 @@ from drake_standup.senses.hardware import IMU_FRAME, ICubHardware, hardware
 from drake_standup.senses.muscles import JointMuscles
 from drake_standup.senses.sensors import RobotSensors
 from drake_standup.world.scene import robot_last_com, set_seated_state
-from drake_standup.world.sensing import RobotSensing, heel_points, thigh_points
+from drake_standup.world.sensing import RobotSensing, buttocks_points, heel_points, thigh_points
 from drake_standup.world.station import Station, pad_load_gains
 
 # The estimates logged beside the truth (signals.npz): name -> the estimator's port.
@@ -45,6 +45,7 @@ _SENSED = (
     "heel_x_W",
     "thigh_x_W",
     "thigh_z_W",
+    "buttocks_z_W",
     "standing_pull_usage",
     "braced_pull_usage",
     "pull_cop_shift_m",
@@ -113,6 +114,7 @@ def add_senses(
             station.standing,
             station.braced,
             last_com=robot_last_com(station.scene),
+            buttocks_points=buttocks_points(robot),
         ),
     )
     builder.Connect(inputs["robot_state"], sensing.GetInputPort("robot_state"))

@@ -9,6 +9,8 @@ soles (6-D). The phase table (phases.py) says when each seat pad's load is relea
     seated pad                 f_z in [min(f_min, F_measured), min(f_max_seat,
                                F_measured + margin)]
     releasing pad              f_z in [0, min(left * F_0, F_measured + margin)]
+    landing pad (sit-down)     f_z in [0, min(landed * max(F_0, F_measured + margin),
+                               F_measured + margin)]: seated at its end, no step
     sole                       f_z in [f_min, f_max_foot]
     seat hold                  the phase's seat_hold (seat_hold_sat_back after a sit-back)
                                until the buttocks' release is over; no rows then
@@ -36,6 +38,7 @@ from drake_standup.config import ControllerConfig
 from drake_standup.config.phases import PhaseTable
 from drake_standup.control.contacts import CHAIR, CONTACTS, SOLES, ContactCommands
 from drake_standup.standup.transitions import (
+    N_STATES,
     StandupMode,
     seat_landings,
     seat_loads,
@@ -161,7 +164,16 @@ class ContactSchedule:
         if not np.count_nonzero(loads):  # every pad released (NaN, seated, counts as nonzero)
             return self._released, np.concatenate((memory[:3], last))
         unload_from = next_unload_from(memory[:3], last, loads)
+        measured = measured_N()
+        target = unload_from
+        if mode.state > N_STATES and measured is not None:
+            # A landing rises to no less than the seated bound (what the pad carries plus
+            # the margin), so its end is no step: a buttocks' release remembered after
+            # they lifted off (20 N) stepped to their seated 97 N at state 1 (Genova01).
+            target = np.maximum(
+                unload_from, np.maximum(measured, 0.0) + self._config.seat_measured_margin_N
+            )
         commands = contact_commands(
-            self._config, loads, unload_from, measured_N(), phase_seat_hold(mode, self._table)
+            self._config, loads, target, measured, phase_seat_hold(mode, self._table)
         )
         return commands, np.concatenate((unload_from, last))

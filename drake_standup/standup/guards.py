@@ -121,9 +121,10 @@ class Measurements:
     seat_fz_N: tuple[float, float, float] = (math.nan, math.nan, math.nan)
     # How often someone asked for the sit-down (live mode's "Sit down" button).
     sit_down: float = 0.0
-    # How high the thigh pads' undersides are above the seat's top (kinematics: on the
-    # iCub, the encoders and the base estimate; NaN: not known). m.
+    # How high the thigh pads' undersides, and the buttocks pad's, are above the seat's
+    # top (kinematics: on the iCub, the encoders and the base estimate; NaN: not known). m.
     thigh_gap_m: float = math.nan
+    buttocks_gap_m: float = math.nan
 
 
 # A pull that lifts the robot uses its reach this many times over (it stays finite

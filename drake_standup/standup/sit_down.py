@@ -152,16 +152,18 @@ def _touches(
     mode: StandupMode, m: Measurements, cfg: StandupConfig, table: PhaseTable
 ) -> StandupMode:
     """The pad groups this phase lands that have touched the seat now: their landing
-    begins (their pads together carry more than sit_down.touch_force_N, or the thighs'
+    begins (their pads together carry more than sit_down.touch_force_N, or their
     undersides are within sit_down.touch_gap_m of the seat's top: a landing the QP
-    lowers exactly onto the seat rests there with 2-6 N, measured)."""
+    lowers exactly onto the seat rests there with 2-6 N, measured; a settle led by its
+    posture left the buttocks hovering over it, 0 N)."""
     phase = table.phase(mode.state)
     land = list(mode.land_s)
+    gaps = {"thighs": m.thigh_gap_m, "buttocks": m.buttocks_gap_m}
     for k, pads in enumerate(SEAT_PADS):
         if pads not in phase.load or not math.isnan(land[k]):
             continue
         force = sum(f for f, name in zip(m.seat_fz_N, SEAT_LOADS, strict=True) if name == pads)
-        near = pads == "thighs" and m.thigh_gap_m <= cfg.sit_down.touch_gap_m
+        near = gaps[pads] <= cfg.sit_down.touch_gap_m
         if force > cfg.sit_down.touch_force_N or near:
             land[k] = m.t
     if tuple(land) == mode.land_s:
@@ -258,9 +260,12 @@ def _seated(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMod
     """State 1 again, every pad seated (no release, no landing), the seat's hold as after
     a sit-back (transitions._sit_back: the reference returns from where it is to where the
     CoM sat at the start over phases.seated.segment_psi); the stand-up may be asked again
-    after sit_down.seated_s."""
+    after sit_down.seated_s. After a phase its posture led (the settle), the return starts
+    where the CoM is: its reference had run on ahead of the CoM (3 cm, the full-weight
+    CoM rows then pulled the body forward onto the buttocks' edge: 54 N on the soles)."""
+    posture_led = table.phase(mode.state).posture_leads
     return dataclasses.replace(
-        _sit_back(mode, m, table),
+        _sit_back(mode, m, table, m.com_W if posture_led else None),
         land_s=(math.nan,) * len(SEAT_PADS),
         creeping=False,
         sit_downs=mode.sit_downs + 1,

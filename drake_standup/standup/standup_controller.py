@@ -18,8 +18,8 @@ estimate (control/model.py), the task references (task_references.py) and the QP
 
 Inputs (a station's outputs of the same names, station.py): robot_state, pad_forces_W,
 seat_pad_normal_forces_N, pads_vertical_force_N, hand_wrenches_W (measured), com_W,
-com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, standing_pull_usage, braced_pull_usage,
-pull_cop_shift_m;
+com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, thigh_z_W, buttocks_z_W,
+standing_pull_usage, braced_pull_usage, pull_cop_shift_m;
 response (1: the response code, config.RESPONSES' index: which of the pull the advancement
 and the task references take, standup/task_references.py); and stand_up (1; > 0.5: start;
 unconnected: never), which only the live helper has.
@@ -61,6 +61,7 @@ _WIRES = [
     ("state_machine", "heel_x_W", "", "heel_x_W"),
     ("state_machine", "thigh_x_W", "", "thigh_x_W"),
     ("state_machine", "thigh_z_W", "", "thigh_z_W"),
+    ("state_machine", "buttocks_z_W", "", "buttocks_z_W"),
     ("state_machine", "standing_pull_usage", "", "standing_pull_usage"),
     ("state_machine", "braced_pull_usage", "", "braced_pull_usage"),
     ("state_machine", "pull_cop_shift_m", "", "pull_cop_shift_m"),

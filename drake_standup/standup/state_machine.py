@@ -31,7 +31,8 @@ class StandupStateMachine(LeafSystem):
     """Periodic (standup.update_period_s) state machine with the mode as abstract state.
 
     Inputs: psi (1), com_W (3), heel_x_W (1), thigh_x_W (1; unconnected: never passed),
-    thigh_z_W (1; unconnected: the thighs' height above the seat unknown),
+    thigh_z_W and buttocks_z_W (1 each; unconnected: the pads' height above the seat
+    unknown),
     standing_pull_usage and braced_pull_usage (1 each; unconnected: 0, and never braced),
     pull_cop_shift_m (1; unconnected: 0), pad_forces_W (3 per pad, rows of the soles
     given as sole_rows = (left, right)), hand_wrenches_W (12, payloads.HAND_WRENCHES),
@@ -73,6 +74,7 @@ class StandupStateMachine(LeafSystem):
         self._heel = self.DeclareVectorInputPort("heel_x_W", 1)
         self._thigh = self.DeclareVectorInputPort("thigh_x_W", 1)
         self._thigh_z = self.DeclareVectorInputPort("thigh_z_W", 1)
+        self._buttocks_z = self.DeclareVectorInputPort("buttocks_z_W", 1)
         self._seat_top_z = seat_top_z_m
         self._usage = self.DeclareVectorInputPort("standing_pull_usage", 1)
         self._braced_usage = self.DeclareVectorInputPort("braced_pull_usage", 1)
@@ -106,6 +108,12 @@ class StandupStateMachine(LeafSystem):
         mode = initial_mode(self._com.Eval(context), context.get_time())
         state.get_mutable_abstract_state(self._mode_index).set_value(mode)
 
+    def _gap(self, port, context: Context) -> float:
+        """How high a pad's underside (port: its z) is above the seat's top; NaN: unknown."""
+        if not port.HasValue(context):
+            return math.nan
+        return float(port.Eval(context)[0]) - self._seat_top_z
+
     def _measure(self, context: Context) -> Measurements:
         pads = self._pads.Eval(context).reshape(-1, 3)
         hands = self._hands.Eval(context).reshape(2, 6)
@@ -127,9 +135,8 @@ class StandupStateMachine(LeafSystem):
             sit_down=float(self._sit_down.Eval(context)[0])
             if self._sit_down.HasValue(context)
             else 0.0,
-            thigh_gap_m=float(self._thigh_z.Eval(context)[0]) - self._seat_top_z
-            if self._thigh_z.HasValue(context)
-            else math.nan,
+            thigh_gap_m=self._gap(self._thigh_z, context),
+            buttocks_gap_m=self._gap(self._buttocks_z, context),
             seat_fz_N=tuple(float(f) for f in self._seat.Eval(context))
             if self._seat.HasValue(context)
             else (math.nan,) * 3,

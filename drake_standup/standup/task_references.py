@@ -141,6 +141,7 @@ class PhaseReferences:
                     returns,
                     phase.stance_throughout,
                     phase.trunk_leads_by,
+                    phase.posture_leads,
                 )
 
     def __getitem__(self, key: int | tuple[int, bool]) -> StateReferences:
@@ -240,6 +241,17 @@ class TaskReferenceGenerator:
         )
         base = _angular_rows(terms, slice(0, 3)) @ wdot
         return base + self._posture_Ldot(terms, self._leaning, q_reference)
+
+    def _com_weight_scale(self, state: StateReferences, progress: float) -> float:
+        """The momentum task's CoM rows' weight scale: 1, or where the posture leads the
+        configured scale, reached over the first posture_led_fade_progress of the path
+        (progress, 0-1) with a smoothstep in its exponent (a decade at a time)."""
+        if not state.posture_leads:
+            return 1.0
+        config = self._config
+        fade = config.posture_led_fade_progress
+        share = 1.0 if fade <= 0.0 or not progress < fade else smoothstep(progress / fade)
+        return config.posture_led_com_weight_scale**share
 
     def _stance(self, state: StateReferences, path_progress: float) -> tuple[float, float]:
         """(how far the legs have taken over the end of the rise, 0-1; the momentum
@@ -341,8 +353,10 @@ class TaskReferenceGenerator:
         )
         trunk_Ldot = self._trunk_Ldot(terms, q_reference, stance)
         R_WB_target = self.base_target(base_yaw, pitch)
-        # On the feet (the lowering, the landing) the contacts lean the body; seated, the seat.
-        if self._leaning is not None and state.posture_returns_to and state.stance_throughout:
+        # Where the legs' posture or the whole posture leads a return (the lowering, the
+        # landing, the settle), the contacts lean the body.
+        leads = state.stance_throughout or state.posture_leads
+        if self._leaning is not None and state.posture_returns_to and leads:
             leaning = self._leaning_Ldot(terms, q_reference, R_WB_target)
             trunk_Ldot = leaning if trunk_Ldot is None else trunk_Ldot + leaning
         momentum = self.momentum.target(
@@ -372,4 +386,5 @@ class TaskReferenceGenerator:
             next_compliance=next_compliance,
             next_momentum_integral=momentum.next_momentum_integral,
             next_posture=next_posture,
+            com_weight_scale=self._com_weight_scale(state, now.descent_progress),
         )

@@ -231,7 +231,9 @@ def _released(phase: Phase) -> list[int]:
     return [i for i, pads in enumerate(SEAT_LOADS) if pads in phase.unload]
 
 
-def _sit_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMode:
+def _sit_back(
+    mode: StandupMode, m: Measurements, table: PhaseTable, start_m: np.ndarray | None = None
+) -> StandupMode:
     """Back to state 1: a pull against the stand-up waits seated (the paper: psi = t,
     nothing advances). The state-1 segment starts where the reference is now (no jump)
     and returns to where the CoM sat at the start, over phases.seated.segment_psi; state
@@ -239,8 +241,9 @@ def _sit_back(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupM
     it was instead, each later forward segment ended its offset further on and the
     robot stood up past its toes (docs/design.md, "Hindering pulls"). "Where
     the reference is" is the one used: its height the CoM's where the segment followed
-    it; the return holds its own height (height_follows off)."""
-    x_now = mode.reference(m.psi, m.com_W)
+    it; the return holds its own height (height_follows off). start_m: where the return
+    starts instead (a sit-down's settle led by its posture: where the CoM is)."""
+    x_now = mode.reference(m.psi, m.com_W) if start_m is None else np.asarray(start_m)
     entry = [m.t] + [math.nan] * (N_MODES - 1)
     return dataclasses.replace(
         mode,

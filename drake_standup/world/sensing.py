@@ -34,9 +34,19 @@ def heel_points(robot: Robot) -> dict[str, np.ndarray]:
 
 def thigh_points(robot: Robot) -> dict[str, np.ndarray]:
     """Thigh frame -> the centre of its pad's bottom face, in that frame."""
+    return _pad_bottoms(robot, "thigh")
+
+
+def buttocks_points(robot: Robot) -> dict[str, np.ndarray]:
+    """The buttocks pad's frame -> the centre of the pad's bottom face, in that frame."""
+    return _pad_bottoms(robot, "buttocks")
+
+
+def _pad_bottoms(robot: Robot, group: str) -> dict[str, np.ndarray]:
+    """Frame -> the centre of the bottom face of group's box pad on it, in that frame."""
     points = {}
     for shape in robot.contact_shapes:
-        if shape.group == "thigh" and shape.shape == "box":
+        if shape.group == group and shape.shape == "box":
             x, y, z = shape.xyz_m
             points[shape.frame] = np.array([x, y, z - shape.size_m[2] / 2])
     return points
@@ -144,7 +154,8 @@ class RobotSensing(LeafSystem):
     of the heels" holds for both feet), thigh_x_W (1, m: the mean x of the
     thigh pads' centres, where the seat's support ends; NaN without pads) and thigh_z_W
     (1, m: the lower of the thigh pads' undersides' centres, how near the seat they are;
-    NaN without pads),
+    NaN without pads), buttocks_z_W (1, m: the buttocks pad's underside's centre; NaN
+    without it),
     hand_positions_W and hand_velocities_W (6 each, m and m/s: the left and the right
     hand frame's origin, where a pull is applied, helper.hands.hand_forces; what the helper's
     work is summed over, helper.work.HelperWork), pull_cop_shift_m (1, m: pull_cop_shift_m of
@@ -167,6 +178,7 @@ class RobotSensing(LeafSystem):
         braced: StandingSupport | None = None,
         *,
         last_com: LastCoM | None = None,
+        buttocks_points: dict[str, np.ndarray] | None = None,
     ):
         """last_com: the controller's model's CoM of the state, where it computed it
         (robot/last_com.py); else from Drake's plant."""
@@ -181,6 +193,10 @@ class RobotSensing(LeafSystem):
         self._thighs = [
             (plant.GetFrameByName(f, self._instance), np.asarray(p))
             for f, p in (thigh_points or {}).items()
+        ]
+        self._buttocks = [
+            (plant.GetFrameByName(f, self._instance), np.asarray(p))
+            for f, p in (buttocks_points or {}).items()
         ]
         self._hands = [robot.frame(plant, name) for name in TASK_FRAMES]
         self._g = -plant.gravity_field().gravity_vector()[2]
@@ -202,6 +218,9 @@ class RobotSensing(LeafSystem):
         )
         self.DeclareVectorOutputPort(
             "thigh_z_W", 1, self._CalcThighZ, prerequisites_of_calc=state_only
+        )
+        self.DeclareVectorOutputPort(
+            "buttocks_z_W", 1, self._CalcButtocksZ, prerequisites_of_calc=state_only
         )
         self.DeclareVectorOutputPort(
             "omega_f_W", 3, self._CalcOmegaF, prerequisites_of_calc={self._wrenches.ticket()}
@@ -280,6 +299,10 @@ class RobotSensing(LeafSystem):
 
     def _CalcThighZ(self, context: Context, output: BasicVector) -> None:
         zs = [float(p[2]) for p in self._points(context, self._thighs)]
+        output.SetAtIndex(0, min(zs) if zs else np.nan)
+
+    def _CalcButtocksZ(self, context: Context, output: BasicVector) -> None:
+        zs = [float(p[2]) for p in self._points(context, self._buttocks)]
         output.SetAtIndex(0, min(zs) if zs else np.nan)
 
     def _CalcHandPositions(self, context: Context, output: BasicVector) -> None:

@@ -18,7 +18,8 @@ Outputs
     seat_pad_normal_forces_N  (3) normal force on the buttocks, left and right thigh pads
     pads_vertical_force_N     (1) the vertical force on all the robot's pads
     hand_wrenches_W           (12) the hands' sensors' wrenches (payloads.HAND_WRENCHES)
-    com_W, com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, thigh_z_W   sensing.py
+    com_W, com_velocity_W, omega_f_W, heel_x_W, thigh_x_W, thigh_z_W,
+    buttocks_z_W              sensing.py
     hand_positions_W, hand_velocities_W   (6 each) where the hands are pulled, m, m/s
     standing_pull_usage       (1) the share of the standing feet's hold a pull needs
     braced_pull_usage         (1) the same with the arms braced (held as seated)
@@ -52,6 +53,7 @@ from drake_standup.world.sensing import (
     FeetReach,
     RobotSensing,
     StandingSupport,
+    buttocks_points,
     heel_points,
     thigh_points,
 )
@@ -273,12 +275,21 @@ def _add_sensing(
             standing,
             braced,
             last_com=robot_last_com(scene),
+            buttocks_points=buttocks_points(robot),
         ),
     )
     robot_state = plant.get_state_output_port(robot.model_instance)
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
     builder.Connect(measured, sensing.GetInputPort("hand_wrenches_W"))
-    for name in ("com_W", "com_velocity_W", "omega_f_W", "heel_x_W", "thigh_x_W", "thigh_z_W"):
+    for name in (
+        "com_W",
+        "com_velocity_W",
+        "omega_f_W",
+        "heel_x_W",
+        "thigh_x_W",
+        "thigh_z_W",
+        "buttocks_z_W",
+    ):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
     for name in (
         "standing_pull_usage",

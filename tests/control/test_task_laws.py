@@ -129,6 +129,10 @@ def test_momentum_task_is_the_wrench_balance_about_drakes_com(rig, seed):
         np.testing.assert_allclose(task.b, expected_b, rtol=1e-9, atol=1e-9)
     assert task.columns == layout.wrenches
     np.testing.assert_array_equal(task.weight, [7.0] * 5 + [7.0 * 0.25])
+    # A phase its posture leads: the CoM rows (force) at their scale, the moment rows whole.
+    led = _references(Ldot_star=Ldot, vertical_weight_scale=0.25, com_weight_scale=1e-3)
+    task.update(terms, led)
+    np.testing.assert_allclose(task.weight, [7.0] * 3 + [7e-3] * 2 + [7e-3 * 0.25], rtol=1e-15)
 
 
 def _joint_rates(plant, context, names):

@@ -3,6 +3,7 @@ seat's hold, from hand-computed cases; and the system's memory over ticks."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 
 from drake_standup.config import ControllerConfig
 from drake_standup.config.phases import PhaseTable
+from drake_standup.control.smooth import smoothstep
 from drake_standup.standup.contact_schedule import (
     CONTACTS,
     ContactSchedule,
@@ -185,3 +187,33 @@ def test_a_failed_tick_keeps_the_last_successful_commands():
     left = 1.0 - PERIOD_S / TABLE.forward.unload_s
     assert commands.max_normal_force_N[0] == pytest.approx(80.0 * left * left * (3 - 2 * left))
     assert len(commands.active) == len(CONTACTS)
+
+
+def test_a_landing_rises_to_the_seated_bound_so_that_seated_is_no_step():
+    """A sit-down's settle lands the buttocks from their touch (land_s) over load_s: their
+    bound is landed * max(F_0, F + margin), and never above F + margin. The release had
+    begun from 20 N (they had lifted off), they carry 50 N: the bound rises to 70 N, the
+    seated bound, where the release's 20 N would have stepped to 70 N at state 1."""
+    schedule = ContactSchedule(CONFIG, TABLE)
+    carried = np.array([50.0, 60.0, 60.0])
+    touch, over = 10.0, TABLE.settle.load_s
+    settle = dataclasses.replace(
+        initial_mode(np.zeros(3)),
+        state=7,
+        release_s=(4.0, 5.0),
+        land_s=(touch, 8.0),  # the thighs landed before: seated
+    )
+    memory = np.concatenate((np.full(3, 20.0), np.full(3, 20.0)))  # F_0 = 20 N each
+    for k, t in enumerate((touch, touch + 0.25 * over, touch + 0.5 * over, touch + over)):
+        commands, _ = schedule.tick(settle, t, memory, np.full(5, 20.0), lambda: carried)
+        landed = smoothstep((t - touch) / over) if t < touch + over else math.nan
+        high = commands.max_normal_force_N[0]
+        if math.isnan(landed):  # seated
+            assert high == pytest.approx(50.0 + MARGIN)
+        else:
+            assert high == pytest.approx(min(landed * (50.0 + MARGIN), 50.0 + MARGIN)), k
+        assert commands.max_normal_force_N[1] == pytest.approx(60.0 + MARGIN)  # seated thighs
+    # On the way up (state 2) the same memory bounds a release by its F_0, as before.
+    forward = dataclasses.replace(settle, state=2, land_s=(math.nan, math.nan))
+    commands, _ = schedule.tick(forward, 4.0, memory, np.full(5, 20.0), lambda: carried)
+    assert commands.max_normal_force_N[0] <= 20.0

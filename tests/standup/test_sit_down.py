@@ -172,6 +172,25 @@ def test_a_landing_begins_at_the_touch_and_its_load_rises_over_load_s():
     assert math.isnan(loads[3][1]) and math.isnan(loads[3][2])  # seated once landed
 
 
+@pytest.mark.parametrize("state, pads, k", [(6, "thigh", 1), (7, "buttocks", 0)])
+def test_a_pad_group_within_touch_gap_of_the_seat_has_touched(state, pads, k):
+    """The touch by kinematics, for the pad group the phase lands (no force yet: a landing
+    the QP lowers exactly onto the seat rests on it with a few newtons, or hovers)."""
+    cfg = _cfg(trigger="hands")
+    gap = cfg.sit_down.touch_gap_m
+    mode = dataclasses.replace(_step(_standing(), _m(9.0, sit_down=1.0), cfg), state=state)
+    mode = dataclasses.replace(mode, release_s=(4.0, 5.0))
+    if state == 7:
+        mode = dataclasses.replace(mode, land_s=(math.nan, 8.0))  # the thighs landed
+    far = next_cycle_mode(mode, _m(10.0, **{f"{pads}_gap_m": gap + 1e-3}), cfg, TABLE)
+    assert math.isnan(far.land_s[k])
+    near = next_cycle_mode(mode, _m(10.0, **{f"{pads}_gap_m": gap - 1e-3}), cfg, TABLE)
+    assert near.land_s[k] == 10.0
+    other = "buttocks" if pads == "thigh" else "thigh"  # the other group's gap: not this one's
+    elsewhere = next_cycle_mode(mode, _m(10.0, **{f"{other}_gap_m": 0.0}), cfg, TABLE)
+    assert math.isnan(elsewhere.land_s[k])
+
+
 def test_an_untouched_pad_at_the_paths_end_creeps_down_from_rest():
     cfg = _cfg(trigger="hands")
     mode = dataclasses.replace(
@@ -221,3 +240,28 @@ def test_settled_the_robot_is_seated_again_and_waits_seated_s_to_stand():
     pull = dict(hands=(20.0, 20.0), up=(20.0, 20.0), com=COM0)
     assert _run(seated, _m(12.0, **pull), cfg, until=13.9).state == 1
     assert _run(seated, _m(12.0, **pull), cfg, until=15.6).state == 2
+
+
+def test_after_a_settle_its_posture_led_the_return_starts_where_the_com_is():
+    """The settle's CoM rows are released (Phase.posture_leads), so its reference is not
+    where the robot is: seated again, the return to where it sat starts at the CoM (and
+    from the reference where the phase held the CoM to it)."""
+    cfg = _cfg(trigger="hands", seated_s=2.0)
+    settle = dataclasses.replace(
+        _step(_standing(), _m(9.0, sit_down=1.0), cfg),
+        state=7,
+        psi_entry=0.0,
+        segment_psi=1.0,
+        land_s=(11.0, 10.0),
+        release_s=(4.0, 5.0),
+    )
+    com = np.array([0.065, 0.0, 0.385])  # behind the settle's reference, which ends at 0.094
+    assert TABLE.settle.posture_leads
+    seated = next_cycle_mode(settle, _m(12.0, com=com), cfg, TABLE)
+    np.testing.assert_allclose(seated.reference(12.0, com), com)
+    np.testing.assert_allclose(seated.segment_end(), COM0)
+    held = dataclasses.replace(TABLE, settle=dataclasses.replace(TABLE.settle, posture_leads=False))
+    from_reference = next_cycle_mode(settle, _m(12.0, com=com), cfg, held)
+    np.testing.assert_allclose(
+        from_reference.reference(12.0, com)[:2], settle.reference(12.0, com)[:2]
+    )

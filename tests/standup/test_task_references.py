@@ -507,12 +507,13 @@ def test_standing_the_contacts_are_asked_the_trunks_posture_moment(rig):
 
 
 def test_lowering_the_contacts_are_asked_the_pelvis_and_trunk_pitch_moment(rig):
-    """In a sit-down's lowering and landing (the phases led by the legs' posture) Ldot_ang*
-    gains A_G,ang [wdot*_WB; qddot*_trunk]: the pelvis toward its pitch target (wdot* =
-    -K_P theta k - K_D w, with Drake's pelvis pose) and the torso's and hips' pitch joints
-    toward the posture reference; each column of A_G,ang is Drake's angular momentum about
-    the CoM with a unit rate of that velocity alone. In the settle (seated), standing and
-    with lowering_attitude off it adds nothing."""
+    """In a sit-down's lowering and landing (the phases led by the legs' posture) and its
+    settle (led by the whole posture) Ldot_ang* gains A_G,ang [wdot*_WB; qddot*_trunk]: the
+    pelvis toward its pitch target (wdot* = -K_P theta k - K_D w, with Drake's pelvis pose)
+    and the torso's and hips' pitch joints toward the posture reference; each column of
+    A_G,ang is Drake's angular momentum about the CoM with a unit rate of that velocity
+    alone. Standing and with lowering_attitude off it adds nothing. Only the settle
+    releases the CoM rows (com_weight_scale)."""
     plant, context, instance, joints = rig["plant"], rig["context"], rig["instance"], rig["joints"]
     names = list(joints.names)
     v_joints = np.asarray(joints.v_indices)
@@ -532,10 +533,10 @@ def test_lowering_the_contacts_are_asked_the_pelvis_and_trunk_pitch_moment(rig):
                 results[on, state] = _calc(rig, state, progress=0.5)[0]
     finally:
         rig["generator"] = plain
-    for state in (4, 7):
-        np.testing.assert_array_equal(
-            results[True, state].Ldot_star, results[False, state].Ldot_star
-        )
+    np.testing.assert_array_equal(results[True, 4].Ldot_star, results[False, 4].Ldot_star)
+    for on in (True, False):
+        scales = [results[on, state].com_weight_scale for state in (4, 5, 6, 7)]
+        assert scales == [1.0, 1.0, 1.0, CONFIG.posture_led_com_weight_scale]
     p, _, _, _ = _drake_com(rig)
     v = rig["x"][plant.num_positions(instance) :]
     q = plant.GetPositions(context, instance)
@@ -554,7 +555,7 @@ def test_lowering_the_contacts_are_asked_the_pelvis_and_trunk_pitch_moment(rig):
     trunk = np.array([column(v_joints[k]) for k in pitch_joints]).T
     kp, zeta = CONFIG.posture_kp_per_s2, CONFIG.posture_damping_ratio
     kp_b, zeta_b = CONFIG.base_orientation_kp_per_s2, CONFIG.base_orientation_damping_ratio
-    for state in (5, 6):
+    for state in (5, 6, 7):
         on = results[True, state]
         q_ref = on.q_reference[pitch_joints]
         q_now = q[joints.q_indices][pitch_joints]
@@ -568,3 +569,20 @@ def test_lowering_the_contacts_are_asked_the_pelvis_and_trunk_pitch_moment(rig):
             on.Ldot_star[:3] - results[False, state].Ldot_star[:3], expected, rtol=1e-9, atol=1e-9
         )
         np.testing.assert_array_equal(on.Ldot_star[3:], results[False, state].Ldot_star[3:])
+
+
+def test_a_posture_led_phase_releases_the_com_rows_a_decade_at_a_time(rig):
+    """The settle (Phase.posture_leads) weighs the momentum task's CoM rows by
+    posture_led_com_weight_scale ** smoothstep(progress / posture_led_fade_progress):
+    1 at the path's start, the scale from the fade's end on (and where the share of the
+    path is unknown, NaN); every other phase 1."""
+    generator, phases = rig["generator"], rig["generator"].phases
+    scale, fade = CONFIG.posture_led_com_weight_scale, CONFIG.posture_led_fade_progress
+    settle = phases[7]
+    assert settle.posture_leads and not any(phases[k].posture_leads for k in range(1, 7))
+    assert generator._com_weight_scale(settle, 0.0) == 1.0
+    half = generator._com_weight_scale(settle, fade / 2)
+    assert half == pytest.approx(scale**0.5, rel=1e-12)  # smoothstep(1/2) = 1/2
+    for progress in (fade, 0.6, 1.0, math.nan):
+        assert generator._com_weight_scale(settle, progress) == scale
+    assert generator._com_weight_scale(phases[5], 0.1) == 1.0

@@ -57,7 +57,9 @@ class MomentumTask(Task):
 
     def update(self, terms: RobotTerms, references: TaskReferences) -> None:
         A, b = self.A, self.b
-        self.weight[5] = self._weight * references.vertical_weight_scale
+        com = self._weight * references.com_weight_scale
+        self.weight[3:5] = com
+        self.weight[5] = com * references.vertical_weight_scale
         A[:] = self._contact_map(terms)[:, :6].T
         A[:3] -= skew(terms.p_BoCom) @ A[3:]
         self._W_gravity[3:] = terms.mass_kg * self._gravity_W
