@@ -176,7 +176,7 @@ class ControllerConfig:
     # In a phase whose posture leads (phases.settle), the momentum task's CoM rows weigh
     # this fraction of the task's weight: at 0.1 the CoM path still won and the torso
     # folded onto its stop; at 1e-4 the pitch the contacts were asked for was met to
-    # 0.01 N m (docs/results.md, "Why the settle rocks").
+    # 0.01 N m (docs/results.md, "The settle led by its posture").
     posture_led_com_weight_scale: float = 1.0e-4
     # ... reached over this share of the phase's path (the scale's exponent a smoothstep
     # of it): released at once, the plan stepped (21 N on the soles on a 0.25 m seat).

@@ -171,12 +171,9 @@ class Phase:
     # ... the trunk (the torso's joints, the hips' pitch, the pelvis' pitch) this many times
     # as fast (all the way once it is that far along).
     trunk_leads_by: float = 1.0
-    # The posture leads and the CoM goes where it puts it: the momentum task's CoM rows
-    # at controller.posture_led_com_weight_scale of their weight, and the contacts asked
-    # for the moment the pelvis and trunk need (controller.lowering_attitude). For a
-    # seated return: its CoM path (to the seat's support line) and its posture (to the
-    # seated pose) end 3.6 cm apart, and, the CoM held to its path, the torso folded
-    # onto its stop as the pelvis turned upright (docs/results.md, "Why the settle rocks").
+    # The posture leads, the CoM goes where it puts it (controller.posture_led_*): held to
+    # the settle's path, which ends 3.6 cm ahead of the seated pose's CoM, the torso folded
+    # onto its stop (docs/results.md, "The settle led by its posture").
     posture_leads: bool = False
     # Its path done with a pad it lands not yet touching the seat, the reference creeps
     # this much lower (over load_s) until the touch; from the touch the reference's
