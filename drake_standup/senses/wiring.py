@@ -27,7 +27,13 @@ from drake_standup.senses.hardware import IMU_FRAME, ICubHardware, hardware
 from drake_standup.senses.muscles import JointMuscles
 from drake_standup.senses.sensors import RobotSensors
 from drake_standup.world.scene import robot_last_com, set_seated_state
-from drake_standup.world.sensing import RobotSensing, buttocks_points, heel_points, thigh_points
+from drake_standup.world.sensing import (
+    SENSED,
+    RobotSensing,
+    buttocks_points,
+    heel_points,
+    thigh_points,
+)
 from drake_standup.world.station import Station, pad_load_gains
 
 # The estimates logged beside the truth (signals.npz): name -> the estimator's port.
@@ -37,19 +43,6 @@ ESTIMATES = {
     "estimated_pad_forces_W": "pad_forces_W",
     "imu_attitude_W": "imu_attitude_W",
 }
-# What the controller reads of the sensing of the estimated state.
-_SENSED = (
-    "com_W",
-    "com_velocity_W",
-    "omega_f_W",
-    "heel_x_W",
-    "thigh_x_W",
-    "thigh_z_W",
-    "buttocks_z_W",
-    "standing_pull_usage",
-    "braced_pull_usage",
-    "pull_cop_shift_m",
-)
 
 
 @dataclass
@@ -119,7 +112,7 @@ def add_senses(
     )
     builder.Connect(inputs["robot_state"], sensing.GetInputPort("robot_state"))
     builder.Connect(inputs["hand_wrenches_W"], sensing.GetInputPort("hand_wrenches_W"))
-    inputs |= {name: sensing.GetOutputPort(name) for name in _SENSED}
+    inputs |= {name: sensing.GetOutputPort(name) for name in SENSED}
     estimates = {name: estimator.GetOutputPort(port) for name, port in ESTIMATES.items()}
     estimates["estimated_com_W"] = sensing.GetOutputPort("com_W")
     estimates["estimated_com_velocity_W"] = sensing.GetOutputPort("com_velocity_W")

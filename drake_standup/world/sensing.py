@@ -21,6 +21,21 @@ from drake_standup.robot.icub import Robot
 from drake_standup.robot.last_com import LastCoM
 from drake_standup.robot.spatial import cross
 
+# The outputs of RobotSensing the controller reads (the station's of the true state, the
+# senses' of the estimated one: senses/wiring.py).
+SENSED = (
+    "com_W",
+    "com_velocity_W",
+    "omega_f_W",
+    "heel_x_W",
+    "thigh_x_W",
+    "thigh_z_W",
+    "buttocks_z_W",
+    "standing_pull_usage",
+    "braced_pull_usage",
+    "pull_cop_shift_m",
+)
+
 
 def heel_points(robot: Robot) -> dict[str, np.ndarray]:
     """Sole frame -> the middle of its pad's rear bottom edge, in that frame."""

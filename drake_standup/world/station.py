@@ -50,6 +50,7 @@ from drake_standup.world.scene import (
     robot_last_com,
 )
 from drake_standup.world.sensing import (
+    SENSED,
     FeetReach,
     RobotSensing,
     StandingSupport,
@@ -281,22 +282,6 @@ def _add_sensing(
     robot_state = plant.get_state_output_port(robot.model_instance)
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
     builder.Connect(measured, sensing.GetInputPort("hand_wrenches_W"))
-    for name in (
-        "com_W",
-        "com_velocity_W",
-        "omega_f_W",
-        "heel_x_W",
-        "thigh_x_W",
-        "thigh_z_W",
-        "buttocks_z_W",
-    ):
-        builder.ExportOutput(sensing.GetOutputPort(name), name)
-    for name in (
-        "standing_pull_usage",
-        "braced_pull_usage",
-        "pull_cop_shift_m",
-        "hand_positions_W",
-        "hand_velocities_W",
-    ):
+    for name in (*SENSED, "hand_positions_W", "hand_velocities_W"):
         builder.ExportOutput(sensing.GetOutputPort(name), name)
     return (standing, braced), robot_state

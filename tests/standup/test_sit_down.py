@@ -223,9 +223,9 @@ def test_a_pull_against_the_landing_holds_the_reference_and_the_landing_goes_on_
     np.testing.assert_allclose(calm.segment_end(), land.segment_end(), atol=1e-12)
 
 
-def test_settled_the_robot_is_seated_again_and_waits_seated_s_to_stand():
-    cfg = _cfg(trigger="hands", seated_s=2.0)
-    settle = dataclasses.replace(
+def _settling(cfg: StandupConfig):
+    """A mode in state 7, its path done (psi 0-1) and both pad groups landed."""
+    return dataclasses.replace(
         _step(_standing(), _m(9.0, sit_down=1.0), cfg),
         state=7,
         psi_entry=0.0,
@@ -233,6 +233,11 @@ def test_settled_the_robot_is_seated_again_and_waits_seated_s_to_stand():
         land_s=(11.0, 10.0),
         release_s=(4.0, 5.0),
     )
+
+
+def test_settled_the_robot_is_seated_again_and_waits_seated_s_to_stand():
+    cfg = _cfg(trigger="hands", seated_s=2.0)
+    settle = _settling(cfg)
     seated = next_cycle_mode(settle, _m(12.0), cfg, TABLE)
     assert seated.state == 1 and seated.sit_downs == 1 and seated.sat_back
     assert all(math.isnan(v) for v in seated.release_s + seated.land_s)
@@ -247,14 +252,7 @@ def test_after_a_settle_its_posture_led_the_return_starts_where_the_com_is():
     where the robot is: seated again, the return to where it sat starts at the CoM (and
     from the reference where the phase held the CoM to it)."""
     cfg = _cfg(trigger="hands", seated_s=2.0)
-    settle = dataclasses.replace(
-        _step(_standing(), _m(9.0, sit_down=1.0), cfg),
-        state=7,
-        psi_entry=0.0,
-        segment_psi=1.0,
-        land_s=(11.0, 10.0),
-        release_s=(4.0, 5.0),
-    )
+    settle = _settling(cfg)
     com = np.array([0.065, 0.0, 0.385])  # behind the settle's reference, which ends at 0.094
     assert TABLE.settle.posture_leads
     seated = next_cycle_mode(settle, _m(12.0, com=com), cfg, TABLE)
