@@ -357,8 +357,8 @@ class TaskReferenceGenerator:
         # landing, the settle), the contacts lean the body.
         leads = state.stance_throughout or state.posture_leads
         if self._leaning is not None and state.posture_returns_to and leads:
-            leaning = self._leaning_Ldot(terms, q_reference, R_WB_target)
-            trunk_Ldot = leaning if trunk_Ldot is None else trunk_Ldot + leaning
+            # The lean's joints hold the standing trunk's (the torso's roll and yaw) too.
+            trunk_Ldot = self._leaning_Ldot(terms, q_reference, R_WB_target)
         momentum = self.momentum.target(
             terms,
             com_target,

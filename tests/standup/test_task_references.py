@@ -586,3 +586,34 @@ def test_a_posture_led_phase_releases_the_com_rows_a_decade_at_a_time(rig):
     for progress in (fade, 0.6, 1.0, math.nan):
         assert generator._com_weight_scale(settle, progress) == scale
     assert generator._com_weight_scale(phases[5], 0.1) == 1.0
+
+
+def test_where_the_body_leans_the_standing_trunks_moment_is_not_asked_twice(rig):
+    """The lean's joints (the torso's three, the hips' pitch) hold the torso's roll and yaw
+    too: in the lowering and the landing (stance 1) the standing trunk's term adds nothing
+    to it, while standing (state 4, stance 1) it is the only trunk term."""
+    joints = rig["joints"]
+    names = list(joints.names)
+    twist = np.array([names.index("torso_roll"), names.index("torso_yaw")])
+    v_joints = np.asarray(joints.v_indices)
+
+    def generator(trunk):
+        return TaskReferenceGenerator(
+            CONFIG, rig["phases"], as_slice(joints.q_indices), T, rig["g"],
+            v_joints=v_joints, trunk=trunk,
+        )  # fmt: skip
+
+    plain = rig["generator"]
+    results = {}
+    try:
+        for held in (True, False):
+            rig["generator"] = generator(twist if held else None)
+            for state in (4, 5, 6):
+                results[held, state] = _calc(rig, state, progress=1.0)[0]
+    finally:
+        rig["generator"] = plain
+    for state in (5, 6):
+        np.testing.assert_array_equal(
+            results[True, state].Ldot_star, results[False, state].Ldot_star
+        )
+    assert np.abs(results[True, 4].Ldot_star[:3] - results[False, 4].Ldot_star[:3]).max() > 1e-6
