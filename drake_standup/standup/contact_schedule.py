@@ -166,7 +166,7 @@ class ContactSchedule:
         unload_from = next_unload_from(memory[:3], last, loads)
         measured = measured_N()
         target = unload_from
-        if mode.state > N_STATES and measured is not None:
+        if mode.state > N_STATES:
             # A landing rises to no less than the seated bound (what the pad carries plus
             # the margin), so its end is no step: a buttocks' release remembered after
             # they lifted off (20 N) stepped to their seated 97 N at state 1 (Genova01).

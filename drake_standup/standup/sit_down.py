@@ -98,8 +98,8 @@ def _next_descent(
     if against:
         if phase.when_hindered == "stand":
             return _stand_again(mode, m, table)
-        if not mode.stepped_back():
-            return _hold(mode, m)
+        if not mode.stepped_back():  # held until the pull eases, then on to the segment's end
+            return held_here(mode, m)
         return mode
     mode = _touches(mode, m, cfg, table)
     calm = m.t - mode.hindered_until_s >= cfg.resume_after_s
@@ -238,12 +238,6 @@ def _enter_descent(
         phase_to_m=to,
         creeping=False,
     )
-
-
-def _hold(mode: StandupMode, m: Measurements) -> StandupMode:
-    """The reference held where it is (psi = t, nothing advances) until the pull against
-    the sit-down eases; the phase then goes on to where its segment was to end."""
-    return held_here(mode, m)
 
 
 def _stand_again(mode: StandupMode, m: Measurements, table: PhaseTable) -> StandupMode:

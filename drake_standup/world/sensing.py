@@ -205,14 +205,8 @@ class RobotSensing(LeafSystem):
         self._context_state: np.ndarray | None = None  # robot_state in self._context
         self._mass_kg = plant.CalcTotalMass(self._context, [self._instance])
         self._heels = [(robot.frame(plant, s), np.asarray(p)) for s, p in heel_points.items()]
-        self._thighs = [
-            (plant.GetFrameByName(f, self._instance), np.asarray(p))
-            for f, p in (thigh_points or {}).items()
-        ]
-        self._buttocks = [
-            (plant.GetFrameByName(f, self._instance), np.asarray(p))
-            for f, p in (buttocks_points or {}).items()
-        ]
+        self._thighs = self._on_frames(thigh_points)
+        self._buttocks = self._on_frames(buttocks_points)
         self._hands = [robot.frame(plant, name) for name in TASK_FRAMES]
         self._g = -plant.gravity_field().gravity_vector()[2]
         nx = plant.num_multibody_states(self._instance)
@@ -260,6 +254,13 @@ class RobotSensing(LeafSystem):
                     self._usage_of(support),
                     prerequisites_of_calc={self._wrenches.ticket()},
                 )
+
+    def _on_frames(self, points: dict[str, np.ndarray] | None) -> list:
+        """(the robot's frame, the point in it) of each frame name -> point."""
+        return [
+            (self._plant.GetFrameByName(f, self._instance), np.asarray(p))
+            for f, p in (points or {}).items()
+        ]
 
     def _set_plant_state(self, context: Context, check: bool) -> None:
         """The private plant context at robot_state (check: unless it is there
@@ -312,13 +313,16 @@ class RobotSensing(LeafSystem):
         xs = self._points_x(context, self._thighs)
         output.SetAtIndex(0, float(np.mean(xs)) if xs else np.nan)
 
+    def _lowest_z(self, context: Context, points: list) -> float:
+        """The lowest world z of the (frame, point in it) at robot_state; NaN: none."""
+        zs = [float(p[2]) for p in self._points(context, points)]
+        return min(zs) if zs else np.nan
+
     def _CalcThighZ(self, context: Context, output: BasicVector) -> None:
-        zs = [float(p[2]) for p in self._points(context, self._thighs)]
-        output.SetAtIndex(0, min(zs) if zs else np.nan)
+        output.SetAtIndex(0, self._lowest_z(context, self._thighs))
 
     def _CalcButtocksZ(self, context: Context, output: BasicVector) -> None:
-        zs = [float(p[2]) for p in self._points(context, self._buttocks)]
-        output.SetAtIndex(0, min(zs) if zs else np.nan)
+        output.SetAtIndex(0, self._lowest_z(context, self._buttocks))
 
     def _CalcHandPositions(self, context: Context, output: BasicVector) -> None:
         self._set_plant_state(context, check=True)
