@@ -27,13 +27,7 @@ from drake_standup.senses.hardware import IMU_FRAME, ICubHardware, hardware
 from drake_standup.senses.muscles import JointMuscles
 from drake_standup.senses.sensors import RobotSensors
 from drake_standup.world.scene import robot_last_com, set_seated_state
-from drake_standup.world.sensing import (
-    SENSED,
-    RobotSensing,
-    buttocks_points,
-    heel_points,
-    thigh_points,
-)
+from drake_standup.world.sensing import SENSED, pad_sensing
 from drake_standup.world.station import Station, pad_load_gains
 
 # The estimates logged beside the truth (signals.npz): name -> the estimator's port.
@@ -99,16 +93,7 @@ def add_senses(
         inputs[name] = system.get_output_port()
     sensing = builder.AddNamedSystem(
         "estimated_sensing",
-        RobotSensing(
-            plant,
-            robot,
-            heel_points(robot),
-            thigh_points(robot),
-            station.standing,
-            station.braced,
-            last_com=robot_last_com(station.scene),
-            buttocks_points=buttocks_points(robot),
-        ),
+        pad_sensing(plant, robot, station.standing, station.braced, robot_last_com(station.scene)),
     )
     builder.Connect(inputs["robot_state"], sensing.GetInputPort("robot_state"))
     builder.Connect(inputs["hand_wrenches_W"], sensing.GetInputPort("hand_wrenches_W"))

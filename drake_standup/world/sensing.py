@@ -373,3 +373,24 @@ class RobotSensing(LeafSystem):
         """
         F = self._wrenches.Eval(context)
         output.SetFromVector((F[3:6] + F[9:12]) / self._mass_kg)
+
+
+def pad_sensing(
+    plant: MultibodyPlant,
+    robot: Robot,
+    standing: StandingSupport | None,
+    braced: StandingSupport | None,
+    last_com: LastCoM | None,
+) -> RobotSensing:
+    """RobotSensing of the robot's heels, thighs and buttocks where its contact shapes put
+    them: the station's (the true state) and the senses' (the estimated one) alike."""
+    return RobotSensing(
+        plant,
+        robot,
+        heel_points(robot),
+        thigh_points(robot),
+        standing,
+        braced,
+        last_com=last_com,
+        buttocks_points=buttocks_points(robot),
+    )

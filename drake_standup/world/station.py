@@ -49,15 +49,7 @@ from drake_standup.world.scene import (
     check_com_heights,
     robot_last_com,
 )
-from drake_standup.world.sensing import (
-    SENSED,
-    FeetReach,
-    RobotSensing,
-    StandingSupport,
-    buttocks_points,
-    heel_points,
-    thigh_points,
-)
+from drake_standup.world.sensing import SENSED, FeetReach, StandingSupport, pad_sensing
 
 # Pad groups as metrics.json reports them (plural where there are two).
 _GROUP_LABELS = {"sole": "soles", "thigh": "thighs", "buttocks": "buttocks"}
@@ -268,16 +260,7 @@ def _add_sensing(
     braced = support(braced_posture(rise.posture_rad, arm_joints), None)
     sensing = builder.AddNamedSystem(
         "sensing",
-        RobotSensing(
-            plant,
-            robot,
-            heel_points(robot),
-            thigh_points(robot),
-            standing,
-            braced,
-            last_com=robot_last_com(scene),
-            buttocks_points=buttocks_points(robot),
-        ),
+        pad_sensing(plant, robot, standing, braced, robot_last_com(scene)),
     )
     robot_state = plant.get_state_output_port(robot.model_instance)
     builder.Connect(robot_state, sensing.GetInputPort("robot_state"))
