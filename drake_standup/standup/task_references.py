@@ -351,7 +351,6 @@ class TaskReferenceGenerator:
         q_reference, next_posture, base_yaw, pitch = self._posture(
             terms, state, carried.posture, psi_dot, now
         )
-        trunk_Ldot = self._trunk_Ldot(terms, q_reference, stance)
         R_WB_target = self.base_target(base_yaw, pitch)
         # Where the legs' posture or the whole posture leads a return (the lowering, the
         # landing, the settle), the contacts lean the body.
@@ -359,6 +358,8 @@ class TaskReferenceGenerator:
         if self._leaning is not None and state.posture_returns_to and leads:
             # The lean's joints hold the standing trunk's (the torso's roll and yaw) too.
             trunk_Ldot = self._leaning_Ldot(terms, q_reference, R_WB_target)
+        else:
+            trunk_Ldot = self._trunk_Ldot(terms, q_reference, stance)
         momentum = self.momentum.target(
             terms,
             com_target,
